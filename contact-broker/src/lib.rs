@@ -1,0 +1,12 @@
+//! Contact algorithms and the step coordinator of the FEM–SPH co-simulation.
+//!
+//! `coordinator`, `probes`, `summary` and `output` are pure (files, no messaging); `transport` is the zenoh
+//! adapter used by the `contact-broker` binary.
+#![warn(missing_docs)]
+
+pub mod coordinator;
+pub mod link;
+pub mod output;
+pub mod probes;
+pub mod summary;
+pub mod transport;

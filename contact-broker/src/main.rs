@@ -1,0 +1,106 @@
+//! `contact-broker`: the step coordinator (and, with fluid, the contact solver) as its own process.
+//!
+//! Prints JSON lines on stdout for the launcher: `{"event":"listening","endpoints":[...]}` once the session is
+//! up, then `{"event":"progress",...}` a few times a second, then `{"event":"done",...}`.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Parser;
+use contact_broker::coordinator::{self, Progress, RunInfo};
+use contact_broker::transport::{self, ZenohFemLink};
+use cosim_proto::keys::{key, topic, valid_run_id};
+
+/// The co-simulation's step coordinator and contact broker.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+struct Args {
+    /// Run id; every key expression is under `cosim/<run>/`.
+    #[arg(long)]
+    run: String,
+    /// Scene file (TOML).
+    #[arg(long)]
+    scene: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// Scene overrides, `key.path=value`.
+    #[arg(long = "set")]
+    set: Vec<String>,
+    /// Endpoints to listen on.
+    #[arg(long, default_value = "tcp/127.0.0.1:0")]
+    listen: Vec<String>,
+    /// Endpoints (a router or peers) to connect to.
+    #[arg(long)]
+    connect: Vec<String>,
+    /// Seconds to wait for the nodes to register.
+    #[arg(long, default_value_t = 60.0)]
+    wait_nodes: f64,
+    /// Mode written into summary.json.
+    #[arg(long, default_value = "processes")]
+    mode: String,
+}
+
+fn main() {
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
+        .with_writer(std::io::stderr)
+        .init();
+    if let Err(e) = run(Args::parse()) {
+        eprintln!("contact-broker: {}", format!("{e:#}").replace('\n', " "));
+        std::process::exit(1);
+    }
+}
+
+fn emit(value: serde_json::Value) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{value}");
+    let _ = out.flush();
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    anyhow::ensure!(valid_run_id(&args.run), "--run `{}`: use letters, digits, - and _ only", args.run);
+    let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let (session, endpoints) = transport::open_listening(&args.listen, &args.connect, 5000)
+        .with_context(|| format!("cannot open a zenoh session (listen {:?}, connect {:?})", args.listen, args.connect))?;
+    // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
+    let subs = transport::subscribe_fem(&session, &args.run)?;
+    let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
+    let _alive = session
+        .liveliness()
+        .declare_token(key(&args.run, topic::BROKER_ALIVE))
+        .wait_ok()?;
+    emit(serde_json::json!({"event": "listening", "endpoints": endpoints, "run": args.run}));
+
+    let wait = Duration::from_secs_f64(args.wait_nodes);
+    let step_timeout = Duration::from_secs_f64(scene.scene.coupling.step_timeout);
+    let mut fem = ZenohFemLink::register(&session, &args.run, subs, wait, step_timeout)?;
+    let info = RunInfo { run_id: args.run.clone(), mode: args.mode.clone(), out: args.out.clone() };
+    let mut last = Instant::now();
+    let mut report = |p: Progress| {
+        if last.elapsed() >= Duration::from_millis(200) || p.t >= p.end_time {
+            last = Instant::now();
+            emit(serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time}));
+        }
+    };
+    let outcome = coordinator::run(&scene, &mut fem, &info, &mut report);
+    emit(serde_json::json!({"event": "done", "status": outcome.summary.status, "message": outcome.summary.message}));
+    match outcome.error {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// `wait()` with the error turned into anyhow.
+trait WaitOk<T> {
+    fn wait_ok(self) -> anyhow::Result<T>;
+}
+
+impl<R: zenoh::Wait + zenoh::Resolvable<To = zenoh::Result<T>>, T> WaitOk<T> for R {
+    fn wait_ok(self) -> anyhow::Result<T> {
+        self.wait().map_err(|e| anyhow::anyhow!("{e}"))
+    }
+}

@@ -1,0 +1,107 @@
+//! Run outputs, the files of the run contract (`DESIGN.md` §5):
+//!
+//! - `DIR/probes.csv`: [`ProbeCsv`], one row per probe sample, flushed row by row;
+//! - `DIR/frames/`: [`FrameWriter`], VTK XML unstructured grids (`.vtu`) with a ParaView collection (`.pvd`)
+//!   per data set, rewritten after every frame;
+//! - `DIR/plots/`: [`plot_probe`], one SVG per probe, with reference data ([`read_reference`]) where the scene
+//!   names it.
+//!
+//! Every error names the file it is about, so the caller can log it in one line and go on.
+
+mod csv;
+mod plot;
+mod pvd;
+mod vtk;
+
+use std::path::{Path, PathBuf};
+
+pub use csv::ProbeCsv;
+pub use plot::{plot_probe, read_reference};
+pub use pvd::PvdCollection;
+pub use vtk::{von_mises_2d, FrameWriter, PointField};
+
+/// An output file could not be written, or an input to it was unusable. Each variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// Reading or writing the file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The VTK library could not encode a frame.
+    #[error("{}: VTK: {message}", path.display())]
+    Vtk {
+        /// The frame file.
+        path: PathBuf,
+        /// vtkio's message.
+        message: String,
+    },
+    /// The plotting library could not draw a plot.
+    #[error("{}: plot: {message}", path.display())]
+    Plot {
+        /// The plot file.
+        path: PathBuf,
+        /// plotters' message.
+        message: String,
+    },
+    /// A reference data file is malformed (missing column, unparsable number).
+    #[error("{}: reference data: {message}", path.display())]
+    Reference {
+        /// The reference CSV file.
+        path: PathBuf,
+        /// What is wrong, with the line where there is one.
+        message: String,
+    },
+    /// The data handed in for a file is inconsistent (array lengths, element sizes, column names).
+    #[error("{}: {message}", path.display())]
+    Input {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Result of the output functions.
+pub type Result<T, E = OutputError> = std::result::Result<T, E>;
+
+impl OutputError {
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
+        Self::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    pub(crate) fn input(path: &Path, message: impl Into<String>) -> Self {
+        Self::Input {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Write `bytes` to `path` through a temporary sibling and a rename, so that a reader (or a run that dies
+/// mid-write) sees either the old file or the new one, never a torn one.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, bytes).map_err(|e| OutputError::io(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
+}
+
+/// A fresh, empty folder under the system temp dir for one test.
+#[cfg(test)]
+pub(crate) fn test_dir(name: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("cosim-output-{}-{name}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

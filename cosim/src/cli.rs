@@ -1,0 +1,64 @@
+//! Command-line arguments (`DESIGN.md` §5, the run contract).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+/// FEM–SPH fluid–structure co-simulation over zenoh.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run a scene: by default contact-broker and the solver nodes as separate processes over zenoh.
+    Run(RunArgs),
+    /// Validate a scene and print what would run.
+    Check(CheckArgs),
+}
+
+/// `cosim run`.
+#[derive(Args, Debug, Clone)]
+pub struct RunArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output folder (default `out/<run.name>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Run every node in this process instead of separate processes.
+    #[arg(long)]
+    pub in_process: bool,
+    /// Override a scene key, `key.path=value` (repeatable), e.g. `--set run.end_time=0.1`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Run id (default: a fresh one).
+    #[arg(long)]
+    pub run_id: Option<String>,
+    /// Connect every node to this zenoh endpoint (a router) instead of peer-to-peer on loopback.
+    #[arg(long)]
+    pub connect: Option<String>,
+    /// Worker threads per node (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// `cosim check`.
+#[derive(Args, Debug, Clone)]
+pub struct CheckArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Override a scene key, `key.path=value` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Print one JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+}

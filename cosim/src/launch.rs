@@ -1,0 +1,242 @@
+//! Processes mode: start `contact-broker` and `fem-node` as OS processes connected over zenoh on loopback, follow
+//! the broker's progress, and make sure no process outlives the run.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use contact_broker::coordinator::{write_summary, Progress, RunInfo};
+use contact_broker::summary::Summary;
+
+use crate::cli::RunArgs;
+use crate::progress::Bar;
+
+/// How long the broker may take to open its session.
+const LISTEN_TIMEOUT: Duration = Duration::from_secs(20);
+/// How long the broker may take to notice a dead node before it is stopped.
+const GRACE: Duration = Duration::from_secs(10);
+
+/// Find a sibling program: `$COSIM_BIN_DIR`, the folder of this executable, then `PATH`.
+pub fn find_program(name: &str) -> anyhow::Result<PathBuf> {
+    let mut places: Vec<PathBuf> = Vec::new();
+    if let Some(dir) = std::env::var_os("COSIM_BIN_DIR") {
+        places.push(PathBuf::from(dir));
+    }
+    if let Some(dir) = std::env::current_exe().ok().and_then(|e| e.parent().map(Path::to_path_buf)) {
+        places.push(dir);
+    }
+    if let Some(path) = std::env::var_os("PATH") {
+        places.extend(std::env::split_paths(&path));
+    }
+    places.iter().map(|d| d.join(name)).find(|p| p.is_file()).ok_or_else(|| {
+        anyhow::anyhow!(
+            "cannot find the `{name}` program (looked in $COSIM_BIN_DIR, next to cosim and on PATH); build it with `cargo build --release`"
+        )
+    })
+}
+
+/// Kills a child when dropped, so an early return never leaves a process behind.
+struct Guard {
+    name: &'static str,
+    child: Child,
+}
+
+impl Guard {
+    fn exited(&mut self) -> Option<std::process::ExitStatus> {
+        self.child.try_wait().ok().flatten()
+    }
+
+    fn wait_for(&mut self, limit: Duration) -> Option<std::process::ExitStatus> {
+        let until = Instant::now() + limit;
+        while Instant::now() < until {
+            if let Some(s) = self.exited() {
+                return Some(s);
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        None
+    }
+}
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        if self.exited().is_none() {
+            tracing::warn!("stopping {}", self.name);
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+fn spawn(name: &'static str, program: &Path, args: &[String], log: &Path, stdout: Stdio) -> anyhow::Result<Guard> {
+    let log_file = std::fs::File::create(log).with_context(|| format!("cannot create {}", log.display()))?;
+    let child = Command::new(program)
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(log_file)
+        .spawn()
+        .with_context(|| format!("cannot start {}", program.display()))?;
+    Ok(Guard { name, child })
+}
+
+/// The last non-empty line of a log, to explain a failure in one line.
+fn last_line(log: &Path) -> String {
+    std::fs::read_to_string(log)
+        .ok()
+        .and_then(|s| s.lines().rev().find(|l| !l.trim().is_empty()).map(str::to_string))
+        .unwrap_or_else(|| "(no message)".into())
+}
+
+/// Events the broker prints on stdout.
+enum Event {
+    Listening(Vec<String>),
+    Progress(Progress),
+}
+
+fn parse_event(line: &str) -> Option<Event> {
+    let v: serde_json::Value = serde_json::from_str(line).ok()?;
+    match v.get("event")?.as_str()? {
+        "listening" => Some(Event::Listening(
+            v.get("endpoints")?.as_array()?.iter().filter_map(|e| e.as_str().map(str::to_string)).collect(),
+        )),
+        "progress" => Some(Event::Progress(Progress {
+            step: v.get("step")?.as_u64()?,
+            t: v.get("t")?.as_f64()?,
+            end_time: v.get("end_time")?.as_f64()?,
+        })),
+        _ => None,
+    }
+}
+
+/// Run the scene as processes and return the broker's summary.
+pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Result<Summary> {
+    let broker_bin = find_program("contact-broker")?;
+    let fem_bin = find_program("fem-node")?;
+    let logs = info.out.join("logs");
+    std::fs::create_dir_all(&logs)?;
+    let broker_log = logs.join("contact-broker.log");
+    let fem_log = logs.join("fem-node.log");
+    let started = Instant::now();
+
+    let mut broker_args = vec![
+        "--run".into(),
+        info.run_id.clone(),
+        "--scene".into(),
+        args.scene.display().to_string(),
+        "--out".into(),
+        info.out.display().to_string(),
+        "--mode".into(),
+        info.mode.clone(),
+    ];
+    for s in &args.set {
+        broker_args.extend(["--set".into(), s.clone()]);
+    }
+    if let Some(c) = &args.connect {
+        broker_args.extend(["--connect".into(), c.clone()]);
+    }
+    let mut broker = spawn("contact-broker", &broker_bin, &broker_args, &broker_log, Stdio::piped())?;
+    let (tx, rx) = mpsc::channel();
+    let stdout = broker.child.stdout.take().expect("piped stdout");
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if let Some(ev) = parse_event(&line) {
+                if tx.send(ev).is_err() {
+                    break;
+                }
+            }
+        }
+    });
+
+    // The broker listens on a port the OS picks, so runs side by side never collide.
+    let endpoints = loop {
+        match rx.recv_timeout(Duration::from_millis(50)) {
+            Ok(Event::Listening(e)) => break e,
+            Ok(Event::Progress(_)) => {}
+            Err(mpsc::RecvTimeoutError::Timeout) | Err(mpsc::RecvTimeoutError::Disconnected) => {}
+        }
+        if broker.exited().is_some() {
+            anyhow::bail!("contact-broker failed to start: {}", last_line(&broker_log));
+        }
+        if started.elapsed() > LISTEN_TIMEOUT {
+            anyhow::bail!("contact-broker did not open its session within {} s", LISTEN_TIMEOUT.as_secs());
+        }
+    };
+    let connect = match &args.connect {
+        Some(c) => c.clone(),
+        None => endpoints
+            .iter()
+            .find(|e| e.starts_with("tcp/"))
+            .cloned()
+            .ok_or_else(|| anyhow::anyhow!("contact-broker listens on no TCP endpoint ({endpoints:?})"))?,
+    };
+    let mut fem_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
+    if let Some(n) = args.threads {
+        fem_args.extend(["--threads".into(), n.to_string()]);
+    }
+    let mut fem = spawn("fem-node", &fem_bin, &fem_args, &fem_log, Stdio::null())?;
+
+    let mut fem_failed_at: Option<Instant> = None;
+    let broker_status = loop {
+        if let Ok(Event::Progress(p)) = rx.recv_timeout(Duration::from_millis(50)) {
+            bar.update(p);
+        }
+        if let Some(status) = broker.exited() {
+            break status;
+        }
+        match (fem.exited(), fem_failed_at) {
+            (Some(s), None) if !s.success() => fem_failed_at = Some(Instant::now()),
+            (_, Some(at)) if at.elapsed() > GRACE => {
+                let _ = broker.child.kill();
+                let status = broker.child.wait()?;
+                break status;
+            }
+            _ => {}
+        }
+    };
+    // The broker told the node to stop; give it a moment to exit, then make sure.
+    fem.wait_for(Duration::from_secs(5));
+    drop(fem);
+
+    let summary_path = info.out.join("summary.json");
+    match std::fs::read_to_string(&summary_path).ok().and_then(|s| serde_json::from_str::<Summary>(&s).ok()) {
+        Some(summary) => Ok(summary),
+        None => {
+            // The broker died before it could write one: write what we know.
+            let message = if broker_status.success() {
+                "contact-broker exited without a summary".to_string()
+            } else {
+                format!("contact-broker: {}; fem-node: {}", last_line(&broker_log), last_line(&fem_log))
+            };
+            let summary = failed_summary(info, message, started.elapsed().as_secs_f64());
+            write_summary(&info.out, &summary)?;
+            Ok(summary)
+        }
+    }
+}
+
+fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {
+    Summary {
+        status: "failed".into(),
+        message,
+        run_id: info.run_id.clone(),
+        scene: String::new(),
+        steps: 0,
+        fem_substeps: 0,
+        sim_time: 0.0,
+        wall_seconds: wall,
+        particles: 0,
+        fem_nodes: 0,
+        fem_elements: 0,
+        solver: "none".into(),
+        contact: "none".into(),
+        mode: info.mode.clone(),
+        frames: 0,
+        samples: 0,
+        timings: Default::default(),
+        contact_stats: Default::default(),
+    }
+}

@@ -1,0 +1,99 @@
+//! `cosim run`: validate the scene, prepare the output folder, run it (processes or in-process), report.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::Context;
+use contact_broker::coordinator::{self, RunInfo};
+use cosim_proto::keys::{fresh_run_id, valid_run_id};
+use cosim_proto::scene::{self, LoadedScene};
+use fem_node::core::FemCore;
+
+use crate::cli::RunArgs;
+use crate::in_process::InProcessFem;
+use crate::launch;
+use crate::progress::Bar;
+
+/// Run a scene; `Err` only for bad input (exit 2), a failed run is exit 1 with one line on stderr.
+pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
+    let scene = scene::load(&args.scene, &args.set)?;
+    let run_id = match &args.run_id {
+        Some(id) if valid_run_id(id) => id.clone(),
+        Some(id) => anyhow::bail!("--run-id `{id}`: use 1–64 letters, digits, - and _"),
+        None => fresh_run_id(),
+    };
+    if let Some(n) = args.threads {
+        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
+    prepare_out(&out, &scene)?;
+    let info = RunInfo {
+        run_id,
+        mode: if args.in_process { "in-process" } else { "processes" }.into(),
+        out: out.clone(),
+    };
+    let bar = Bar::new(args.quiet);
+    let result = if args.in_process {
+        run_in_process(args, &scene, &info, &bar)
+    } else {
+        launch::run_processes(args, &info, &bar)
+    };
+    bar.finish();
+    match result {
+        Ok(summary) if summary.status == "ok" => {
+            println!(
+                "ok: {} steps to t = {} s in {:.2} s ({}) -> {}",
+                summary.steps,
+                summary.sim_time,
+                summary.wall_seconds,
+                summary.mode,
+                out.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Ok(summary) => {
+            eprintln!("cosim: run {}: {} (outputs so far in {})", summary.status, summary.message, out.display());
+            Ok(ExitCode::from(1))
+        }
+        Err(e) => {
+            eprintln!("cosim: {} (outputs so far in {})", format!("{e:#}").replace('\n', " "), out.display());
+            Ok(ExitCode::from(1))
+        }
+    }
+}
+
+/// Create the folder, clear the outputs of an earlier run there, and keep the resolved scene beside them.
+fn prepare_out(out: &Path, scene: &LoadedScene) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    for stale in ["frames", "plots", "logs"] {
+        let dir = out.join(stale);
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).with_context(|| format!("cannot clear {}", dir.display()))?;
+        }
+    }
+    for stale in ["summary.json", "probes.csv"] {
+        let _ = std::fs::remove_file(out.join(stale));
+    }
+    std::fs::write(out.join("scene.toml"), scene.scene.to_toml())
+        .with_context(|| format!("cannot write {}", out.join("scene.toml").display()))?;
+    Ok(())
+}
+
+fn run_in_process(
+    args: &RunArgs,
+    scene: &LoadedScene,
+    info: &RunInfo,
+    bar: &Bar,
+) -> anyhow::Result<contact_broker::summary::Summary> {
+    if let Some(n) = args.threads {
+        rayon_threads(n)?;
+    }
+    let core = FemCore::new(&scene.scene).context("fem-node")?;
+    let mut fem = InProcessFem::new(core);
+    let outcome = coordinator::run(scene, &mut fem, info, &mut |p| bar.update(p));
+    Ok(outcome.summary)
+}
+
+fn rayon_threads(n: usize) -> anyhow::Result<()> {
+    rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| anyhow::anyhow!("--threads {n}: {e}"))
+}

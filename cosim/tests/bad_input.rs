@@ -1,0 +1,208 @@
+//! Bad input never panics: every case exits non-zero within seconds with one line naming the file, the key and
+//! the problem.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use common::*;
+
+const LIMIT: Duration = Duration::from_secs(30);
+
+/// A valid structure-only scene; each case edits one thing.
+const GOOD: &str = r#"
+version = 1
+[run]
+name = "bad"
+end_time = 0.01
+output_interval = 0.005
+[[solid]]
+name = "beam"
+min = [0.0, 0.0]
+max = [0.1, 0.01]
+divisions = [10, 2]
+material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1.0e6, poisson_ratio = 0.3 }
+fixed = [{ min = [-0.001, -0.001], max = [0.001, 0.011] }]
+[[probe]]
+name = "tip"
+kind = "node_displacement"
+solid = "beam"
+point = [0.1, 0.005]
+component = "y"
+"#;
+
+fn write_scene(name: &str, text: &str) -> PathBuf {
+    let dir = scratch(&format!("bad-{name}"));
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Runs `cosim run` on the scene and returns (exit code, stderr).
+fn run_scene(name: &str, text: &str) -> (i32, String) {
+    let path = write_scene(name, text);
+    let out_dir = path.parent().unwrap().join("out");
+    let out = cosim_run(&["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--quiet"], LIMIT);
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn assert_refused(name: &str, text: &str, key: &str, words: &str) {
+    let (code, err) = run_scene(name, text);
+    assert_eq!(code, 2, "{name}: exit code; stderr: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{name}: one line expected, got: {err}");
+    let line = lines[0];
+    assert!(line.contains(&format!("{name}.toml")), "{name}: file not named: {line}");
+    assert!(line.contains(key), "{name}: key `{key}` not named: {line}");
+    assert!(line.contains(words), "{name}: `{words}` not said: {line}");
+    assert!(!line.contains("panicked"), "{name}: {line}");
+}
+
+#[test]
+fn unknown_key() {
+    assert_refused("unknown", &GOOD.replace("divisions = [10, 2]", "divisions = [10, 2]\ncolour = 3"), "solid[0].colour", "unknown key");
+}
+
+#[test]
+fn missing_key() {
+    assert_refused("missing", &GOOD.replace("end_time = 0.01\n", ""), "run.end_time", "missing key");
+}
+
+#[test]
+fn youngs_modulus_not_positive() {
+    assert_refused("young", &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = 0.0"), "solid[0].material.youngs_modulus", "positive");
+    assert_refused("young_neg", &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = -5.0"), "solid[0].material.youngs_modulus", "positive");
+}
+
+#[test]
+fn poisson_ratio_out_of_range() {
+    assert_refused("nu_half", &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"), "solid[0].material.poisson_ratio", "[0, 0.5)");
+    assert_refused("nu_neg", &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = -0.1"), "solid[0].material.poisson_ratio", "[0, 0.5)");
+}
+
+#[test]
+fn density_not_positive() {
+    assert_refused("density", &GOOD.replace("density = 1000.0", "density = 0.0"), "solid[0].material.density", "positive");
+}
+
+#[test]
+fn zero_divisions() {
+    assert_refused("divisions", &GOOD.replace("divisions = [10, 2]", "divisions = [10, 0]"), "solid[0].divisions", "at least 1");
+}
+
+#[test]
+fn fixed_box_without_nodes() {
+    let text = GOOD.replace("max = [0.001, 0.011] }", "max = [0.001, 0.011] }, { min = [0.2, 0.2], max = [0.3, 0.3] }");
+    assert_refused("fixed", &text, "solid[0].fixed[1]", "holds no node");
+}
+
+#[test]
+fn probe_names_a_missing_solid() {
+    assert_refused("probe", &GOOD.replace("solid = \"beam\"", "solid = \"gate\""), "probe[0].solid", "no solid named `gate`");
+}
+
+#[test]
+fn end_time_not_positive() {
+    assert_refused("end", &GOOD.replace("end_time = 0.01", "end_time = 0.0"), "run.end_time", "positive");
+    assert_refused("end_neg", &GOOD.replace("end_time = 0.01", "end_time = -1.0"), "run.end_time", "positive");
+}
+
+#[test]
+fn wrong_type_and_syntax_error() {
+    assert_refused("type", &GOOD.replace("end_time = 0.01", "end_time = \"soon\""), "run.end_time", "invalid type");
+    assert_refused("syntax", &GOOD.replace("[run]", "[run"), "line", "");
+}
+
+#[test]
+fn bad_override_names_the_set_key() {
+    let path = write_scene("set", GOOD);
+    let out = cosim_run(&["check", path.to_str().unwrap(), "--set", "solid[0].material.poisson_ratio=0.7"], LIMIT);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("solid[0].material.poisson_ratio") && err.contains("[0, 0.5)"), "{err}");
+    let out = cosim_run(&["check", path.to_str().unwrap(), "--set", "run.colour=1"], LIMIT);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("run.colour") && err.contains("unknown key"), "{err}");
+}
+
+#[test]
+fn missing_scene_file() {
+    let out = cosim_run(&["run", "/nonexistent/scene.toml", "--quiet"], LIMIT);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("/nonexistent/scene.toml") && err.contains("cannot read"), "{err}");
+}
+
+#[test]
+fn missing_fem_node_program_is_reported_within_seconds() {
+    // A folder holding cosim and the broker but no fem-node, and a PATH without it.
+    let dir = scratch("nofem");
+    for p in ["cosim", "contact-broker"] {
+        std::fs::copy(program(p), dir.join(p)).unwrap();
+    }
+    let scene = write_scene("nofem_scene", GOOD);
+    let start = Instant::now();
+    let out = run_bounded(
+        Command::new(dir.join("cosim"))
+            .args(["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap(), "--quiet"])
+            .env("PATH", "/usr/bin:/bin")
+            .env_remove("COSIM_BIN_DIR"),
+        LIMIT,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(0));
+    assert!(err.contains("cannot find the `fem-node` program"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(10), "took {:?}", start.elapsed());
+}
+
+#[test]
+fn node_that_cannot_connect_fails_within_seconds() {
+    let port = free_port();
+    let start = Instant::now();
+    let out = run_bounded(
+        Command::new(program("fem-node")).args([
+            "--run",
+            &run_id("noconnect"),
+            "--connect",
+            &format!("tcp/127.0.0.1:{port}"),
+            "--timeout",
+            "2",
+        ]),
+        LIMIT,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("cannot connect to tcp/127.0.0.1:"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(10), "took {:?}", start.elapsed());
+}
+
+#[test]
+fn node_with_no_broker_on_its_run_fails_within_seconds() {
+    // A broker of another run listens; the node asks for a run nobody serves.
+    let dir = scratch("wrongrun");
+    let scene = write_scene("wrongrun_scene", GOOD);
+    let mut broker = Command::new(program("contact-broker"))
+        .args(["--run", &run_id("served"), "--scene", scene.to_str().unwrap(), "--out", dir.to_str().unwrap(), "--wait-nodes", "20"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(broker.stdout.as_mut().unwrap()), &mut line).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+    let endpoint = v["endpoints"].as_array().unwrap().iter().find_map(|e| e.as_str().filter(|e| e.starts_with("tcp/"))).unwrap().to_string();
+    let start = Instant::now();
+    let out = run_bounded(
+        Command::new(program("fem-node")).args(["--run", &run_id("unserved"), "--connect", &endpoint, "--timeout", "2"]),
+        LIMIT,
+    );
+    let _ = broker.kill();
+    let _ = broker.wait();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("no broker of run"), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(10), "took {:?}", start.elapsed());
+}

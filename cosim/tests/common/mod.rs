@@ -1,0 +1,77 @@
+//! Shared helpers of the end-to-end tests: run the real binaries with a bounded wait.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// The `cosim` binary under test; its siblings (`fem-node`, `contact-broker`) sit in the same folder.
+pub fn cosim() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_cosim"))
+}
+
+/// Folder of the built programs.
+pub fn bin_dir() -> PathBuf {
+    cosim().parent().unwrap().to_path_buf()
+}
+
+/// A sibling program, which must have been built (`cargo build --release` before `cargo test --release`).
+pub fn program(name: &str) -> PathBuf {
+    let p = bin_dir().join(name);
+    assert!(p.is_file(), "{} is missing: run `cargo build --release` before the tests", p.display());
+    p
+}
+
+/// The workspace root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+}
+
+/// A fresh empty folder for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cosim-test-{}-{}", name, std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Run a command, killing it after `limit`; panics on a timeout so no test can hang.
+pub fn run_bounded(cmd: &mut Command, limit: Duration) -> Output {
+    let mut child = cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let start = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().unwrap();
+            panic!(
+                "{cmd:?} did not finish within {limit:?}; stderr: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// `cosim ARGS` with a bounded wait.
+pub fn cosim_run(args: &[&str], limit: Duration) -> Output {
+    run_bounded(Command::new(cosim()).args(args).env("COSIM_BIN_DIR", bin_dir()), limit)
+}
+
+/// A unique run id per test.
+pub fn run_id(name: &str) -> String {
+    format!("t{}-{}", std::process::id(), name)
+}
+
+/// Read a JSON file.
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+        .unwrap()
+}
+
+/// A free TCP port on loopback (nobody listens on it once this returns).
+pub fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}

@@ -1,0 +1,136 @@
+//! `cosim run` of a structure-only scene end to end: the outputs of the run contract, processes against
+//! in-process replay, thread-count independence and isolation of concurrent runs.
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+
+const LIMIT: Duration = Duration::from_secs(240);
+
+/// The shipped CSM3 scene, shortened.
+fn csm3_args<'a>(out: &'a str, run: &'a str, end: &'a str) -> Vec<&'a str> {
+    vec!["run", "scenes/csm3.toml", "--out", out, "--run-id", run, "--set", end, "--quiet"]
+}
+
+fn run_ok(args: &[&str]) -> std::process::Output {
+    let out = std::process::Command::new(cosim())
+        .current_dir(root())
+        .args(args)
+        .env("COSIM_BIN_DIR", bin_dir())
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped());
+    let out = run_bounded(out, LIMIT);
+    assert!(
+        out.status.success(),
+        "cosim {args:?} failed: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn processes_run_writes_every_output_of_the_contract() {
+    let dir = scratch("contract");
+    let out = dir.join("out");
+    let out_s = out.to_str().unwrap();
+    run_ok(&csm3_args(out_s, &run_id("contract"), "run.end_time=0.2"));
+
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["status"], "ok");
+    assert_eq!(s["mode"], "processes");
+    assert_eq!(s["sim_time"].as_f64().unwrap(), 0.2);
+    assert_eq!(s["fem_nodes"].as_u64().unwrap(), 71 * 5);
+    assert_eq!(s["fem_elements"].as_u64().unwrap(), 70 * 4);
+    assert_eq!(s["particles"].as_u64().unwrap(), 0);
+    // max_dt 0.002 and output every 0.01: 100 coupling steps.
+    assert_eq!(s["steps"].as_u64().unwrap(), 100);
+    for k in ["fem", "sph", "broker", "messaging"] {
+        assert!(s["timings"][k].as_f64().unwrap() >= 0.0, "timings.{k}");
+    }
+    for k in ["contacts", "max_penetration", "linear_momentum_change", "angular_momentum_change"] {
+        assert!(s["contact_stats"][k].is_number(), "contact_stats.{k}");
+    }
+
+    let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next().unwrap(), "t,tip_ux,tip_uy,energy_total");
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 21, "samples at t = 0, 0.01, ..., 0.2");
+    assert_eq!(rows[0][0], 0.0);
+    assert_eq!(rows[0][2], 0.0, "starts undeformed");
+    assert!((rows[20][0] - 0.2).abs() < 1e-12);
+    assert!(rows[20][2] < -1e-3, "the bar sags under gravity: tip_uy = {}", rows[20][2]);
+
+    let frames = out.join("frames");
+    let vtu = std::fs::read_dir(&frames).unwrap().filter(|e| {
+        e.as_ref().unwrap().path().extension().is_some_and(|x| x == "vtu")
+    });
+    assert_eq!(vtu.count(), 21);
+    let pvd = std::fs::read_to_string(frames.join("structure.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 21);
+    for p in ["tip_ux", "tip_uy", "energy_total"] {
+        let plot = out.join("plots").join(format!("{p}.svg"));
+        assert!(std::fs::metadata(&plot).map(|m| m.len() > 500).unwrap_or(false), "{} missing", plot.display());
+    }
+    let svg = std::fs::read_to_string(out.join("plots/tip_uy.svg")).unwrap();
+    assert!(svg.contains("Turek"), "the reference is drawn and labelled");
+}
+
+#[test]
+fn in_process_and_processes_give_identical_probes_for_any_thread_count() {
+    let dir = scratch("replay");
+    let a = dir.join("processes");
+    let b = dir.join("in-process");
+    let c = dir.join("in-process-1-thread");
+    let d = dir.join("processes-2-threads");
+    let end = "run.end_time=0.3";
+    run_ok(&csm3_args(a.to_str().unwrap(), &run_id("replay-a"), end));
+    run_ok(&[csm3_args(b.to_str().unwrap(), &run_id("replay-b"), end), vec!["--in-process"]].concat());
+    run_ok(&[csm3_args(c.to_str().unwrap(), &run_id("replay-c"), end), vec!["--in-process", "--threads", "1"]].concat());
+    run_ok(&[csm3_args(d.to_str().unwrap(), &run_id("replay-d"), end), vec!["--threads", "2"]].concat());
+    let read = |p: &std::path::Path| std::fs::read(p.join("probes.csv")).unwrap();
+    let reference = read(&a);
+    assert!(reference.len() > 100);
+    assert_eq!(read(&b), reference, "in-process differs from processes");
+    assert_eq!(read(&c), reference, "1 thread differs");
+    assert_eq!(read(&d), reference, "2 threads differ");
+    assert_eq!(json(&b.join("summary.json"))["mode"], "in-process");
+}
+
+#[test]
+fn two_runs_at_once_do_not_collide() {
+    let dir = scratch("concurrent");
+    let a = dir.join("a");
+    let b = dir.join("b");
+    let (ia, ib) = (run_id("conc-a"), run_id("conc-b"));
+    let args_a = csm3_args(a.to_str().unwrap(), &ia, "run.end_time=0.1");
+    let args_b = [csm3_args(b.to_str().unwrap(), &ib, "run.end_time=0.1"), vec!["--set", "solid[0].material.youngs_modulus=2.8e6"]].concat();
+    let (ra, rb) = std::thread::scope(|s| {
+        let ta = s.spawn(|| run_ok(&args_a));
+        let tb = s.spawn(|| run_ok(&args_b));
+        (ta.join().unwrap(), tb.join().unwrap())
+    });
+    assert!(ra.status.success() && rb.status.success());
+    let (pa, pb) = (std::fs::read(a.join("probes.csv")).unwrap(), std::fs::read(b.join("probes.csv")).unwrap());
+    assert_ne!(pa, pb, "different stiffness must give different probes: the runs crossed");
+    assert_eq!(json(&a.join("summary.json"))["run_id"], ia.as_str());
+    assert_eq!(json(&b.join("summary.json"))["run_id"], ib.as_str());
+}
+
+#[test]
+fn check_prints_what_would_run() {
+    let out = cosim_run(
+        &["check", root().join("scenes/csm3.toml").to_str().unwrap(), "--json"],
+        Duration::from_secs(30),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fem_nodes"].as_u64().unwrap(), 355);
+    assert_eq!(doc["fem_elements"].as_u64().unwrap(), 280);
+    assert_eq!(doc["coupling_steps"].as_u64().unwrap(), 5000);
+    assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
+}

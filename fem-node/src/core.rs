@@ -1,0 +1,70 @@
+//! The FEM node's message handler: turns step commands into states. No messaging here — the zenoh adapter
+//! (`node.rs`) and the in-process launcher both call it, so the two modes compute the same bits.
+
+use std::time::Instant;
+
+use cosim_proto::messages::{FemMesh, FemState, StepCommand};
+use cosim_proto::scene::Scene;
+
+use crate::error::FemError;
+use crate::model::FemModel;
+use crate::solver::FemSolver;
+
+/// A structure node: the solver plus what it tells the broker.
+pub struct FemCore {
+    solver: FemSolver,
+    mesh: FemMesh,
+    interface_nodes: Vec<u32>,
+}
+
+impl FemCore {
+    /// Build the model of every solid of the scene.
+    pub fn new(scene: &Scene) -> Result<Self, FemError> {
+        let model = FemModel::build(scene)?;
+        let solver = FemSolver::new(model, scene.coupling.fem_cfl)?;
+        let mesh = solver.mesh_message();
+        let mut interface_nodes: Vec<u32> = mesh.interface.iter().flat_map(|s| [s.a, s.b]).collect();
+        interface_nodes.sort_unstable();
+        interface_nodes.dedup();
+        Ok(Self { solver, mesh, interface_nodes })
+    }
+
+    /// The `fem/mesh` registration message.
+    pub fn mesh(&self) -> &FemMesh {
+        &self.mesh
+    }
+
+    /// The solver (tests, checkpoints).
+    pub fn solver(&self) -> &FemSolver {
+        &self.solver
+    }
+
+    /// Apply the corrections, advance by `dt`, and answer. `None` for a stop command.
+    pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<FemState>, FemError> {
+        let started = Instant::now();
+        self.solver.apply_corrections(&cmd.corrections);
+        if cmd.stop {
+            return Ok(None);
+        }
+        let substeps = if cmd.dt > 0.0 { self.solver.advance(cmd.dt)? } else { 0 };
+        let state = self.solver.state();
+        let (ids, x, v) = if cmd.want_interface {
+            let ids = self.interface_nodes.clone();
+            let x = ids.iter().map(|&n| state.x[n as usize]).collect();
+            let v = ids.iter().map(|&n| state.v[n as usize]).collect();
+            (ids, x, v)
+        } else {
+            (Vec::new(), Vec::new(), Vec::new())
+        };
+        let snapshot = cmd.want_snapshot.then(|| self.solver.snapshot());
+        Ok(Some(FemState {
+            ids,
+            x,
+            v,
+            substeps,
+            dt_stable: self.solver.stable_dt(),
+            compute_seconds: started.elapsed().as_secs_f64(),
+            snapshot,
+        }))
+    }
+}

@@ -1,0 +1,62 @@
+//! The solver state that defines a run (serializable, for restarts and snapshots), kept apart from the per-step
+//! scratch memory (which is only workspace and is not serialized).
+
+use serde::{Deserialize, Serialize};
+
+use crate::element::ElementForces;
+use crate::model::FemModel;
+
+/// Positions, velocities and accelerations of all nodes at time `t`, after `step` sub-steps.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FemState {
+    /// Simulated time \[s\].
+    pub t: f64,
+    /// Sub-steps taken so far.
+    pub step: u64,
+    /// Current positions `x` \[m\].
+    pub x: Vec<[f64; 2]>,
+    /// Full-step velocities `v` [m/s].
+    pub v: Vec<[f64; 2]>,
+    /// Accelerations `a` [m/s²] of the current positions.
+    pub a: Vec<[f64; 2]>,
+}
+
+impl FemState {
+    /// The model at rest in its reference configuration (accelerations still to be computed).
+    pub fn at_rest(model: &FemModel) -> Self {
+        let n = model.node_count();
+        Self {
+            t: 0.0,
+            step: 0,
+            x: model.reference().to_vec(),
+            v: vec![[0.0; 2]; n],
+            a: vec![[0.0; 2]; n],
+        }
+    }
+
+    /// Displacement `x − X` of node `k`.
+    pub fn displacement(&self, model: &FemModel, k: usize) -> [f64; 2] {
+        let r = model.reference()[k];
+        [self.x[k][0] - r[0], self.x[k][1] - r[1]]
+    }
+}
+
+/// Per-step workspace: element force buffers and the assembled internal forces. This contains only workspace
+/// data, so there is no point in making it serializable.
+#[derive(Clone, Debug, Default)]
+pub struct FemScratch {
+    /// Nodal forces of every element, written in parallel.
+    pub element_forces: Vec<ElementForces>,
+    /// Assembled internal forces per node.
+    pub internal: Vec<[f64; 2]>,
+}
+
+impl FemScratch {
+    /// Buffers sized for `model`.
+    pub fn new(model: &FemModel) -> Self {
+        Self {
+            element_forces: vec![[[0.0; 2]; 4]; model.elements().len()],
+            internal: vec![[0.0; 2]; model.node_count()],
+        }
+    }
+}

@@ -1,0 +1,125 @@
+//! The versioned envelope every message travels in, and its bincode codec (`DESIGN.md` §3, `docs/PROTOCOL.md`).
+
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
+
+/// Protocol version this build speaks.
+pub const PROTOCOL_VERSION: u32 = 1;
+
+/// `{protocol_version, run, step, t, body}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Envelope<B> {
+    /// Must equal [`PROTOCOL_VERSION`].
+    pub protocol_version: u32,
+    /// Run id; must equal the receiver's.
+    pub run: String,
+    /// Coupling step the message belongs to.
+    pub step: u64,
+    /// Simulated time [s].
+    pub t: f64,
+    /// The message.
+    pub body: B,
+}
+
+/// Why a message was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum CodecError {
+    /// The bytes do not decode as the expected message.
+    #[error("malformed {what} message ({len} bytes): {source}")]
+    Malformed {
+        /// Expected message type.
+        what: &'static str,
+        /// Payload length.
+        len: usize,
+        /// Decoder error.
+        source: bincode::Error,
+    },
+    /// Another protocol version.
+    #[error("{what} message speaks protocol version {got}, this build speaks {PROTOCOL_VERSION}")]
+    Version {
+        /// Expected message type.
+        what: &'static str,
+        /// Version found.
+        got: u32,
+    },
+    /// Another run.
+    #[error("{what} message belongs to run `{got}`, not `{expected}`")]
+    Run {
+        /// Expected message type.
+        what: &'static str,
+        /// Run found.
+        got: String,
+        /// Run expected.
+        expected: String,
+    },
+    /// Another step.
+    #[error("{what} message is for step {got}, expected step {expected}")]
+    Step {
+        /// Expected message type.
+        what: &'static str,
+        /// Step found.
+        got: u64,
+        /// Step expected.
+        expected: u64,
+    },
+}
+
+/// Largest message accepted by the decoder (guards against length prefixes that claim gigabytes).
+pub const MAX_MESSAGE_BYTES: u64 = 1 << 30;
+
+/// One fixed configuration, documented byte for byte in docs/PROTOCOL.md: little endian, fixed-width integers,
+/// u64 length prefixes.
+fn encoder() -> impl bincode::Options {
+    use bincode::Options;
+    bincode::DefaultOptions::new().with_little_endian().with_fixint_encoding()
+}
+
+/// The encoder's layout; no trailing bytes, and no length prefix may claim more than [`MAX_MESSAGE_BYTES`].
+fn options() -> impl bincode::Options {
+    use bincode::Options;
+    encoder().reject_trailing_bytes().with_limit(MAX_MESSAGE_BYTES)
+}
+
+impl<B: Serialize> Envelope<B> {
+    /// Wrap a body for the current protocol version.
+    pub fn new(run: &str, step: u64, t: f64, body: B) -> Self {
+        Self { protocol_version: PROTOCOL_VERSION, run: run.to_string(), step, t, body }
+    }
+
+    /// Encode with the fixed bincode configuration.
+    pub fn encode(&self) -> Vec<u8> {
+        use bincode::Options;
+        // Serialising plain data into memory with no size limit has no failure path.
+        encoder().serialize(self).expect("in-memory bincode encoding of plain data")
+    }
+}
+
+impl<B: DeserializeOwned> Envelope<B> {
+    /// Decode and check version and run. `what` names the message in errors.
+    pub fn decode(bytes: &[u8], run: &str, what: &'static str) -> Result<Self, CodecError> {
+        use bincode::Options;
+        // The first 4 bytes are always the version: check it before the body so a newer peer gets a version
+        // error, not a decode error, whatever its layout.
+        if let Some(h) = bytes.get(..4) {
+            let version = u32::from_le_bytes([h[0], h[1], h[2], h[3]]);
+            if version != PROTOCOL_VERSION {
+                return Err(CodecError::Version { what, got: version });
+            }
+        }
+        let env: Envelope<B> = options()
+            .deserialize(bytes)
+            .map_err(|source| CodecError::Malformed { what, len: bytes.len(), source })?;
+        if env.run != run {
+            return Err(CodecError::Run { what, got: env.run, expected: run.to_string() });
+        }
+        Ok(env)
+    }
+
+    /// Refuse a message for another step.
+    pub fn expect_step(self, step: u64, what: &'static str) -> Result<Self, CodecError> {
+        if self.step == step {
+            Ok(self)
+        } else {
+            Err(CodecError::Step { what, got: self.step, expected: step })
+        }
+    }
+}

@@ -1,0 +1,11 @@
+//! Wire messages, the versioned envelope and its codec, key expressions, and the scene types of the
+//! FEM–SPH co-simulation. Nothing here does I/O beyond reading a scene file.
+#![warn(missing_docs)]
+
+pub mod envelope;
+pub mod keys;
+pub mod messages;
+pub mod scene;
+pub mod session;
+
+pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

@@ -1,0 +1,121 @@
+//! Message bodies carried in an [`Envelope`](crate::Envelope), one type per topic (`DESIGN.md` §3).
+//!
+//! Positions and vectors are `[f64; 2]` (2D). Node ids are indices into the FE node list of [`FemMesh`].
+
+use serde::{Deserialize, Serialize};
+
+/// A boundary segment of the structure, from node `a` to node `b`. The structure lies on the left of a→b
+/// (boundaries run counter-clockwise), so the outward unit normal is `(dy, −dx) / L`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Segment {
+    /// First node id.
+    pub a: u32,
+    /// Second node id.
+    pub b: u32,
+}
+
+/// Topic `fem/mesh` (fem → broker, once): the reference mesh, masses and interface segments.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FemMesh {
+    /// Names of the solids, in scene order.
+    pub solid_names: Vec<String>,
+    /// Reference position of every node.
+    pub nodes: Vec<[f64; 2]>,
+    /// Lumped mass of every node, per unit thickness [kg/m].
+    pub masses: Vec<f64>,
+    /// Solid index of every node.
+    pub node_solid: Vec<u32>,
+    /// Element connectivity (3 or 4 node ids, counter-clockwise).
+    pub cells: Vec<Vec<u32>>,
+    /// Solid index of every element.
+    pub cell_solid: Vec<u32>,
+    /// Outer boundary segments of all solids (the contact masters).
+    pub interface: Vec<Segment>,
+    /// Clamped node ids.
+    pub fixed: Vec<u32>,
+    /// Stable FEM step of the reference configuration [s].
+    pub dt_stable: f64,
+}
+
+/// A sparse correction to one particle or node: position and velocity increments.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Correction {
+    /// Node or particle id.
+    pub id: u32,
+    /// Position increment [m].
+    pub dx: [f64; 2],
+    /// Velocity increment [m/s].
+    pub dv: [f64; 2],
+}
+
+/// Topics `broker/fem` and `broker/sph` (broker → node, each step): corrections to apply, then the step to take.
+///
+/// The node applies `corrections`, then advances by `dt` (no advance when `dt == 0`), then answers with its state
+/// for the same envelope step. With `stop` set the node answers nothing and exits cleanly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepCommand {
+    /// Coupling step to advance by [s].
+    pub dt: f64,
+    /// Corrections from the previous contact pass.
+    pub corrections: Vec<Correction>,
+    /// Region of interest `[xmin, ymin, xmax, ymax]`; the fluid node sends only particles inside it.
+    pub roi: Option<[f64; 4]>,
+    /// Send the interface state in the answer.
+    pub want_interface: bool,
+    /// Send a full snapshot in the answer (an output time).
+    pub want_snapshot: bool,
+    /// End of run: exit after applying the corrections.
+    pub stop: bool,
+}
+
+/// Energies of one solid [J per unit thickness].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Energies {
+    /// ½ Σ m v².
+    pub kinetic: f64,
+    /// Σ_e W(F_e) A_e.
+    pub strain: f64,
+    /// −Σ m g·(x − X).
+    pub potential: f64,
+}
+
+/// A full structure snapshot for frames and probes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FemSnapshot {
+    /// Current node positions.
+    pub x: Vec<[f64; 2]>,
+    /// Node velocities.
+    pub v: Vec<[f64; 2]>,
+    /// Cauchy stress per element `[σxx, σyy, σxy]` [Pa].
+    pub stress: Vec<[f64; 3]>,
+    /// Energies per solid, in scene order.
+    pub energies: Vec<Energies>,
+}
+
+/// Topic `fem/state` (fem → broker, each step).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FemState {
+    /// Interface node ids (empty unless asked for).
+    pub ids: Vec<u32>,
+    /// Their positions.
+    pub x: Vec<[f64; 2]>,
+    /// Their velocities.
+    pub v: Vec<[f64; 2]>,
+    /// FEM sub-steps taken for this coupling step.
+    pub substeps: u32,
+    /// Current stable FEM step [s].
+    pub dt_stable: f64,
+    /// Seconds of computation this step took on the node.
+    pub compute_seconds: f64,
+    /// Full snapshot when asked for.
+    pub snapshot: Option<FemSnapshot>,
+}
+
+/// Topic `<node>/error` (node → broker): the node failed and is about to exit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeError {
+    /// `unstable` for a numerical blow-up, `failed` otherwise.
+    pub status: String,
+    /// One line saying what went wrong.
+    pub message: String,
+}

@@ -1,0 +1,656 @@
+//! Scene files (TOML, SI units): the types of `DESIGN.md` §5.1, loading with `--set` overrides, and validation.
+//!
+//! Every user error is a [`SceneError`]: one line naming the file, the dotted key and the problem.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// The scene format version this build reads.
+pub const SCENE_VERSION: u32 = 1;
+
+/// A whole scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Format version; must be [`SCENE_VERSION`].
+    pub version: u32,
+    /// Run-wide settings.
+    pub run: RunSpec,
+    /// Elastic structures (`[[solid]]`).
+    #[serde(default, rename = "solid", skip_serializing_if = "Vec::is_empty")]
+    pub solids: Vec<SolidSpec>,
+    /// Contact algorithm settings.
+    #[serde(default)]
+    pub contact: ContactSpec,
+    /// Coupling (step) settings.
+    #[serde(default)]
+    pub coupling: CouplingSpec,
+    /// Probes sampled every `run.output_interval` (`[[probe]]`).
+    #[serde(default, rename = "probe", skip_serializing_if = "Vec::is_empty")]
+    pub probes: Vec<ProbeSpec>,
+}
+
+/// `[run]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSpec {
+    /// Name used in outputs.
+    pub name: String,
+    /// Simulated end time [s].
+    pub end_time: f64,
+    /// Gravity [m/s²].
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 2],
+    /// Interval between frames and probe samples [s].
+    pub output_interval: f64,
+}
+
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.81]
+}
+
+/// Finite element type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ElementKind {
+    /// 4-node quadrilateral, one-point integration with hourglass control.
+    Quad4,
+    /// 3-node constant-strain triangle.
+    Tri3,
+}
+
+/// Constitutive model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModel {
+    /// Small-strain Hooke's law in a corotational frame (large rotations stay exact).
+    LinearElastic,
+    /// Compressible neo-Hookean.
+    NeoHookean,
+    /// St. Venant–Kirchhoff (the Turek–Hron benchmarks use it).
+    StVenantKirchhoff,
+}
+
+/// `material = { ... }` of a solid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Model.
+    pub model: MaterialModel,
+    /// Density [kg/m³].
+    pub density: f64,
+    /// Young's modulus [Pa].
+    pub youngs_modulus: f64,
+    /// Poisson's ratio, in [0, 0.5).
+    pub poisson_ratio: f64,
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Lower corner.
+    pub min: [f64; 2],
+    /// Upper corner.
+    pub max: [f64; 2],
+}
+
+impl BoxSpec {
+    /// True if `p` lies inside the box (bounds included).
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        (0..2).all(|k| p[k] >= self.min[k] && p[k] <= self.max[k])
+    }
+}
+
+/// `[[solid]]`: a rectangle meshed with `divisions[0] × divisions[1]` cells.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidSpec {
+    /// Unique name, referenced by probes.
+    pub name: String,
+    /// Lower corner of the rectangle.
+    pub min: [f64; 2],
+    /// Upper corner of the rectangle.
+    pub max: [f64; 2],
+    /// Cells along x and y.
+    pub divisions: [u32; 2],
+    /// Element type; `tri3` splits each cell into two triangles.
+    #[serde(default = "default_element")]
+    pub element: ElementKind,
+    /// Material.
+    pub material: MaterialSpec,
+    /// Nodes inside any of these boxes are clamped.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed: Vec<BoxSpec>,
+    /// Mass-proportional damping coefficient [1/s] (force −c·m·v); 0 (default) is undamped.
+    #[serde(default)]
+    pub damping: f64,
+}
+
+fn default_element() -> ElementKind {
+    ElementKind::Quad4
+}
+
+impl SolidSpec {
+    /// Number of grid nodes along x and y.
+    pub fn grid_size(&self) -> [usize; 2] {
+        [self.divisions[0] as usize + 1, self.divisions[1] as usize + 1]
+    }
+
+    /// Reference position of grid node (i, j); node numbering is `j * nx + i`.
+    pub fn grid_node(&self, i: usize, j: usize) -> [f64; 2] {
+        let [nx, ny] = self.grid_size();
+        let fx = i as f64 / (nx - 1) as f64;
+        let fy = j as f64 / (ny - 1) as f64;
+        [
+            self.min[0] + (self.max[0] - self.min[0]) * fx,
+            self.min[1] + (self.max[1] - self.min[1]) * fy,
+        ]
+    }
+
+    /// All grid nodes in numbering order.
+    pub fn grid_nodes(&self) -> Vec<[f64; 2]> {
+        let [nx, ny] = self.grid_size();
+        (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| (i, j)))
+            .map(|(i, j)| self.grid_node(i, j))
+            .collect()
+    }
+
+    /// Number of elements the mesh will have.
+    pub fn element_count(&self) -> usize {
+        let cells = self.divisions[0] as usize * self.divisions[1] as usize;
+        match self.element {
+            ElementKind::Quad4 => cells,
+            ElementKind::Tri3 => 2 * cells,
+        }
+    }
+}
+
+/// Contact algorithm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactAlgorithm {
+    /// Long et al. 2016 particle–element contact.
+    ParticleElement,
+    /// Repulsive-force baseline.
+    ParticleParticle,
+    /// No contact.
+    None,
+}
+
+/// `[contact]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Algorithm.
+    #[serde(default = "default_algorithm")]
+    pub algorithm: ContactAlgorithm,
+    /// Contact thickness r_c [m]; default spacing / 2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Gauss–Seidel sweeps.
+    #[serde(default = "default_sweeps")]
+    pub sweeps: u32,
+}
+
+fn default_algorithm() -> ContactAlgorithm {
+    ContactAlgorithm::ParticleElement
+}
+
+fn default_sweeps() -> u32 {
+    3
+}
+
+impl Default for ContactSpec {
+    fn default() -> Self {
+        Self { algorithm: default_algorithm(), thickness: None, sweeps: default_sweeps() }
+    }
+}
+
+/// `[coupling]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSpec {
+    /// Cap on the coupling step [s].
+    #[serde(default = "default_max_dt")]
+    pub max_dt: f64,
+    /// Safety factor on the FEM stable step, Δt_fem = fem_cfl · min_e(L_e / c_d).
+    #[serde(default = "default_fem_cfl")]
+    pub fem_cfl: f64,
+    /// Seconds a node may take to answer one step before the run fails.
+    #[serde(default = "default_step_timeout")]
+    pub step_timeout: f64,
+}
+
+fn default_max_dt() -> f64 {
+    1.0e-3
+}
+
+fn default_fem_cfl() -> f64 {
+    0.9
+}
+
+fn default_step_timeout() -> f64 {
+    60.0
+}
+
+impl Default for CouplingSpec {
+    fn default() -> Self {
+        Self { max_dt: default_max_dt(), fem_cfl: default_fem_cfl(), step_timeout: default_step_timeout() }
+    }
+}
+
+/// Probe kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProbeKind {
+    /// Displacement of the FE node nearest `point` (reference configuration), `component` x or y.
+    NodeDisplacement,
+    /// Energy of the structures: `part` = kinetic | strain | potential | total; optional `solid`.
+    Energy,
+}
+
+/// A vector component.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Component {
+    /// x.
+    X,
+    /// y.
+    Y,
+}
+
+impl Component {
+    /// Index into a 2-vector.
+    pub fn index(self) -> usize {
+        match self {
+            Component::X => 0,
+            Component::Y => 1,
+        }
+    }
+}
+
+/// Energy part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergyPart {
+    /// ½ m v².
+    Kinetic,
+    /// Stored elastic energy.
+    Strain,
+    /// −m g·x relative to the reference configuration.
+    Potential,
+    /// Sum of the three.
+    Total,
+}
+
+/// `[[probe]]`. Flat so that a missing or misplaced key gets a precise message.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    /// Column name in `probes.csv`.
+    pub name: String,
+    /// Kind.
+    pub kind: ProbeKind,
+    /// Solid name (node_displacement; optional for energy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solid: Option<String>,
+    /// Point (node_displacement).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 2]>,
+    /// Component (node_displacement).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component: Option<Component>,
+    /// Energy part (energy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<EnergyPart>,
+    /// Reference data drawn in the plot: a CSV file (relative to the scene file) and its columns.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<ReferenceSpec>,
+}
+
+/// Reference curve for a probe's plot.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// CSV file with a header row; relative paths are relative to the scene file.
+    pub file: String,
+    /// Column holding time.
+    pub t: String,
+    /// Column holding the value.
+    pub value: String,
+    /// Label in the legend.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+    /// Multiply the value column by this (e.g. to change units).
+    #[serde(default = "one")]
+    pub scale: f64,
+    /// Add this to the time column.
+    #[serde(default)]
+    pub t_offset: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// A user error in a scene: one line naming the file, the key and the problem.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}: {key}: {message}")]
+pub struct SceneError {
+    /// Scene file (or `--set` for an override).
+    pub file: String,
+    /// Dotted key path, e.g. `solid[0].material.youngs_modulus`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl SceneError {
+    fn new(file: &str, key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self { file: file.to_string(), key: key.into(), message: message.into() }
+    }
+}
+
+/// A scene with where it came from.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The validated scene.
+    pub scene: Scene,
+    /// The file it was read from.
+    pub path: PathBuf,
+}
+
+impl LoadedScene {
+    /// Resolve a path written in the scene (relative to the scene file's folder).
+    pub fn resolve(&self, relative: &str) -> PathBuf {
+        let p = Path::new(relative);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.path.parent().unwrap_or(Path::new(".")).join(p)
+        }
+    }
+}
+
+/// Read, override and validate a scene file. `overrides` are `key.path=value` strings (`--set`).
+pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::new(&file, "(file)", format!("cannot read: {e}")))?;
+    let scene = parse(&file, &text, overrides)?;
+    Ok(LoadedScene { scene, path: path.to_path_buf() })
+}
+
+/// Parse, override and validate scene text; `file` names it in errors.
+pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+    let mut value: toml::Value = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+    for o in overrides {
+        apply_override(&mut value, o).map_err(|(key, msg)| SceneError::new(file, format!("--set {key}"), msg))?;
+    }
+    let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner().to_string();
+        let (key, message) = key_of_serde_error(&path, &inner);
+        SceneError::new(file, key, message)
+    })?;
+    scene.validate().map_err(|(key, msg)| SceneError::new(file, key, msg))?;
+    Ok(scene)
+}
+
+/// One line for a TOML syntax error: the line number and toml's own message.
+fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> SceneError {
+    let key = match e.span() {
+        Some(span) => format!("line {}", text[..span.start.min(text.len())].matches('\n').count() + 1),
+        None => "(syntax)".to_string(),
+    };
+    SceneError::new(file, key, e.message().replace('\n', " "))
+}
+
+/// Make the key of a serde error the full dotted path of the offending field.
+fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
+    let parent = if path == "." { String::new() } else { path.to_string() };
+    // serde_path_to_error already ends the path with an unknown field, but not with a missing one.
+    let join = |field: &str| {
+        if parent.is_empty() {
+            field.to_string()
+        } else if parent == field || parent.ends_with(&format!(".{field}")) {
+            parent.clone()
+        } else {
+            format!("{parent}.{field}")
+        }
+    };
+    let field_in = |prefix: &str| {
+        message.strip_prefix(prefix).and_then(|rest| rest.split('`').next()).map(str::to_string)
+    };
+    if let Some(field) = field_in("unknown field `") {
+        return (join(&field), "unknown key".to_string());
+    }
+    if let Some(field) = field_in("missing field `") {
+        return (join(&field), "missing key".to_string());
+    }
+    let key = if parent.is_empty() { "(top level)".to_string() } else { parent };
+    (key, message.replace('\n', " "))
+}
+
+/// Apply one `key.path=value` override. Paths take `name`, `name[3]` or `name.3` segments; an array of tables
+/// with a single element may be addressed without an index.
+fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), (String, String)> {
+    let (path, raw) = assignment
+        .split_once('=')
+        .ok_or_else(|| (assignment.to_string(), "expected key.path=value".to_string()))?;
+    let path = path.trim();
+    let fail = |msg: String| (path.to_string(), msg);
+    let value = parse_value(raw.trim());
+    let mut segments = Vec::new();
+    for part in path.split('.') {
+        if part.is_empty() {
+            return Err(fail("empty segment in key path".into()));
+        }
+        match part.split_once('[') {
+            Some((name, rest)) => {
+                let index = rest
+                    .strip_suffix(']')
+                    .and_then(|i| i.parse::<usize>().ok())
+                    .ok_or_else(|| fail(format!("bad index in `{part}`")))?;
+                if !name.is_empty() {
+                    segments.push(Segment::Key(name.to_string()));
+                }
+                segments.push(Segment::Index(index));
+            }
+            None => match part.parse::<usize>() {
+                Ok(i) => segments.push(Segment::Index(i)),
+                Err(_) => segments.push(Segment::Key(part.to_string())),
+            },
+        }
+    }
+    let mut node = root;
+    let n = segments.len();
+    for (k, seg) in segments.into_iter().enumerate() {
+        let last = k + 1 == n;
+        // An array addressed by name alone: step into its only element.
+        let array_len = node.as_array().map(Vec::len);
+        if let (Segment::Key(_), Some(len)) = (&seg, array_len) {
+            if len != 1 {
+                return Err(fail(format!("is an array of {len} items; give an index")));
+            }
+            node = node.as_array_mut().and_then(|a| a.first_mut()).expect("one item");
+        }
+        node = match seg {
+            Segment::Key(name) => {
+                let table =
+                    node.as_table_mut().ok_or_else(|| fail(format!("`{name}` is not inside a table")))?;
+                if last {
+                    table.insert(name, value);
+                    return Ok(());
+                }
+                table.entry(name).or_insert_with(|| toml::Value::Table(toml::map::Map::new()))
+            }
+            Segment::Index(i) => {
+                let items = node.as_array_mut().ok_or_else(|| fail(format!("[{i}] applied to a non-array")))?;
+                let len = items.len();
+                let item = items.get_mut(i).ok_or_else(|| fail(format!("index {i} out of range ({len} items)")))?;
+                if last {
+                    *item = value;
+                    return Ok(());
+                }
+                item
+            }
+        };
+    }
+    Err(fail("empty key path".into()))
+}
+
+enum Segment {
+    Key(String),
+    Index(usize),
+}
+
+/// A TOML value if the text parses as one, else a bare string (so `--set fluid.solver=isph` works unquoted).
+fn parse_value(raw: &str) -> toml::Value {
+    #[derive(Deserialize)]
+    struct Holder {
+        v: toml::Value,
+    }
+    toml::from_str::<Holder>(&format!("v = {raw}")).map(|h| h.v).unwrap_or_else(|_| toml::Value::String(raw.to_string()))
+}
+
+type Invalid = (String, String);
+
+fn check(ok: bool, key: impl FnOnce() -> String, message: impl FnOnce() -> String) -> Result<(), Invalid> {
+    if ok {
+        Ok(())
+    } else {
+        Err((key(), message()))
+    }
+}
+
+fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
+    check(v.is_finite() && v > 0.0, || key.to_string(), || format!("must be a positive number, got {v}"))
+}
+
+impl Scene {
+    /// Checks every value a solver relies on. Returns the dotted key and the problem.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        check(
+            self.version == SCENE_VERSION,
+            || "version".into(),
+            || format!("this build reads version {SCENE_VERSION}, the file says {}", self.version),
+        )?;
+        check(!self.run.name.trim().is_empty(), || "run.name".into(), || "must not be empty".into())?;
+        finite_positive("run.end_time", self.run.end_time)?;
+        finite_positive("run.output_interval", self.run.output_interval)?;
+        check(
+            self.run.gravity.iter().all(|g| g.is_finite()),
+            || "run.gravity".into(),
+            || "must be finite".into(),
+        )?;
+        finite_positive("coupling.max_dt", self.coupling.max_dt)?;
+        finite_positive("coupling.step_timeout", self.coupling.step_timeout)?;
+        check(
+            // Above 0.94 elongated tri3 meshes go unstable (their characteristic length is an estimate).
+            self.coupling.fem_cfl > 0.0 && self.coupling.fem_cfl <= 0.9,
+            || "coupling.fem_cfl".into(),
+            || format!("must be in (0, 0.9], got {}", self.coupling.fem_cfl),
+        )?;
+        if let Some(t) = self.contact.thickness {
+            finite_positive("contact.thickness", t)?;
+        }
+        check(self.contact.sweeps >= 1, || "contact.sweeps".into(), || "must be at least 1".into())?;
+        for (s, solid) in self.solids.iter().enumerate() {
+            self.validate_solid(s, solid)?;
+        }
+        let mut names: Vec<&str> = Vec::new();
+        for (p, probe) in self.probes.iter().enumerate() {
+            let key = |k: &str| format!("probe[{p}].{k}");
+            check(!probe.name.trim().is_empty() && !probe.name.contains(','), || key("name"), || {
+                "must be non-empty and contain no comma".into()
+            })?;
+            check(!names.contains(&probe.name.as_str()), || key("name"), || {
+                format!("`{}` is used by another probe", probe.name)
+            })?;
+            names.push(&probe.name);
+            if let Some(name) = &probe.solid {
+                check(self.solids.iter().any(|s| &s.name == name), || key("solid"), || {
+                    format!("no solid named `{name}` (solids: {})", self.solid_names())
+                })?;
+            }
+            match probe.kind {
+                ProbeKind::NodeDisplacement => {
+                    check(probe.solid.is_some(), || key("solid"), || "missing key (node_displacement)".into())?;
+                    check(probe.point.is_some(), || key("point"), || "missing key (node_displacement)".into())?;
+                    check(probe.component.is_some(), || key("component"), || {
+                        "missing key (node_displacement)".into()
+                    })?;
+                }
+                ProbeKind::Energy => {
+                    check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
+                }
+            }
+            if let Some(r) = &probe.reference {
+                finite_positive(&key("reference.scale"), r.scale.abs())?;
+            }
+        }
+        Ok(())
+    }
+
+    fn solid_names(&self) -> String {
+        if self.solids.is_empty() {
+            return "none".into();
+        }
+        self.solids.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+    }
+
+    fn validate_solid(&self, s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
+        let key = |k: &str| format!("solid[{s}].{k}");
+        check(!solid.name.trim().is_empty(), || key("name"), || "must not be empty".into())?;
+        check(
+            !self.solids[..s].iter().any(|o| o.name == solid.name),
+            || key("name"),
+            || format!("`{}` is used by another solid", solid.name),
+        )?;
+        for k in 0..2 {
+            check(
+                solid.min[k].is_finite() && solid.max[k].is_finite() && solid.max[k] > solid.min[k],
+                || key("max"),
+                || format!("must be greater than min in every component, got min {:?} max {:?}", solid.min, solid.max),
+            )?;
+            check(solid.divisions[k] > 0, || key("divisions"), || {
+                format!("must be at least 1 in every component, got {:?}", solid.divisions)
+            })?;
+        }
+        let m = &solid.material;
+        finite_positive(&key("material.density"), m.density)?;
+        finite_positive(&key("material.youngs_modulus"), m.youngs_modulus)?;
+        check(
+            m.poisson_ratio.is_finite() && (0.0..0.5).contains(&m.poisson_ratio),
+            || key("material.poisson_ratio"),
+            || format!("must be in [0, 0.5), got {}", m.poisson_ratio),
+        )?;
+        check(solid.damping.is_finite() && solid.damping >= 0.0, || key("damping"), || {
+            format!("must be zero or positive, got {}", solid.damping)
+        })?;
+        let nodes = solid.grid_nodes();
+        for (f, b) in solid.fixed.iter().enumerate() {
+            check(nodes.iter().any(|&p| b.contains(p)), || key(&format!("fixed[{f}]")), || {
+                format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max)
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Total FE nodes and elements.
+    pub fn fem_counts(&self) -> (usize, usize) {
+        self.solids.iter().fold((0, 0), |(n, e), s| {
+            let [nx, ny] = s.grid_size();
+            (n + nx * ny, e + s.element_count())
+        })
+    }
+
+    /// The scene as TOML text (used to hand the resolved scene to the nodes).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a validated scene serialises")
+    }
+}

@@ -1,0 +1,27 @@
+//! The zenoh session settings every node uses, as `(key, json5 value)` pairs for `zenoh::Config::insert_json5`,
+//! so that no crate but the node adapters depends on zenoh.
+
+/// Settings of a peer session: multicast scouting off (gossip stays on so peers that only know a hub find each
+/// other), listen on `listen`, connect to `connect`, and fail within `timeout_ms` when a connect endpoint does
+/// not answer instead of retrying forever.
+pub fn peer_settings(listen: &[String], connect: &[String], timeout_ms: u64) -> Vec<(String, String)> {
+    let list = |v: &[String]| {
+        let quoted: Vec<String> = v.iter().map(|e| format!("{e:?}")).collect();
+        format!("[{}]", quoted.join(","))
+    };
+    let mut s = vec![
+        ("mode".to_string(), "\"peer\"".to_string()),
+        ("scouting/multicast/enabled".to_string(), "false".to_string()),
+        ("listen/endpoints".to_string(), list(listen)),
+        ("connect/endpoints".to_string(), list(connect)),
+    ];
+    if !connect.is_empty() {
+        s.push(("connect/timeout_ms".to_string(), timeout_ms.to_string()));
+        s.push(("connect/exit_on_failure".to_string(), "true".to_string()));
+    }
+    if !listen.is_empty() {
+        s.push(("listen/timeout_ms".to_string(), timeout_ms.to_string()));
+        s.push(("listen/exit_on_failure".to_string(), "true".to_string()));
+    }
+    s
+}

@@ -1,0 +1,67 @@
+//! Scene parsing: `--set` overrides, error keys, round trip of the resolved scene.
+
+use cosim_proto::scene::{parse, ElementKind, MaterialModel};
+
+const SCENE: &str = r#"
+version = 1
+[run]
+name = "s"
+end_time = 1.0
+output_interval = 0.1
+[[solid]]
+name = "a"
+min = [0.0, 0.0]
+max = [1.0, 0.1]
+divisions = [10, 1]
+material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, poisson_ratio = 0.3 }
+"#;
+
+fn err(text: &str, sets: &[&str]) -> String {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    parse("f.toml", text, &sets).unwrap_err().to_string()
+}
+
+#[test]
+fn defaults_and_overrides_by_index_name_and_single_item() {
+    let s = parse("f.toml", SCENE, &[]).unwrap();
+    assert_eq!(s.run.gravity, [0.0, -9.81]);
+    assert_eq!(s.solids[0].element, ElementKind::Quad4);
+    assert_eq!(s.coupling.max_dt, 1e-3);
+    let sets = [
+        "run.end_time=0.25",
+        "solid[0].material.youngs_modulus=2e6",
+        "solid.0.divisions=[20, 2]",
+        "solid.material.model=neo_hookean",
+        "solid[0].element=tri3",
+        "coupling.max_dt=5e-4",
+    ]
+    .map(String::from);
+    let s = parse("f.toml", SCENE, &sets).unwrap();
+    assert_eq!(s.run.end_time, 0.25);
+    assert_eq!(s.solids[0].material.youngs_modulus, 2e6);
+    assert_eq!(s.solids[0].divisions, [20, 2]);
+    assert_eq!(s.solids[0].material.model, MaterialModel::NeoHookean);
+    assert_eq!(s.solids[0].element, ElementKind::Tri3);
+    assert_eq!(s.coupling.max_dt, 5e-4);
+}
+
+#[test]
+fn errors_name_file_and_key() {
+    assert_eq!(err(SCENE, &["run.speed=3"]), "f.toml: run.speed: unknown key");
+    assert_eq!(err(&SCENE.replace("name = \"s\"\n", ""), &[]), "f.toml: run.name: missing key");
+    assert_eq!(
+        err(SCENE, &["solid[0].material.poisson_ratio=0.5"]),
+        "f.toml: solid[0].material.poisson_ratio: must be in [0, 0.5), got 0.5"
+    );
+    assert!(err(SCENE, &["solid[3].name=x"]).starts_with("f.toml: --set solid[3].name: index 3 out of range"));
+    assert!(err(SCENE, &["novalue"]).contains("expected key.path=value"));
+    assert!(err(&SCENE.replace("version = 1", "version = 2"), &[]).contains("version: this build reads version 1"));
+    assert!(err(SCENE, &["solid[0].element=hex8"]).starts_with("f.toml: solid[0].element: unknown variant `hex8`"));
+}
+
+#[test]
+fn resolved_scene_round_trips_through_toml() {
+    let s = parse("f.toml", SCENE, &["run.end_time=0.5".into()]).unwrap();
+    let again = parse("resolved", &s.to_toml(), &[]).unwrap();
+    assert_eq!(s, again);
+}
