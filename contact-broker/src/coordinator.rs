@@ -47,12 +47,7 @@ pub struct Outcome {
 const LANDING: f64 = 1e-9;
 
 /// Run a scene to its end time (or to the first failure) and write every output.
-pub fn run(
-    scene: &LoadedScene,
-    fem: &mut dyn FemLink,
-    info: &RunInfo,
-    progress: &mut dyn FnMut(Progress),
-) -> Outcome {
+pub fn run(scene: &LoadedScene, fem: &mut dyn FemLink, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
     let started = Instant::now();
     let s = &scene.scene;
     let (fem_nodes, fem_elements) = (fem.mesh().nodes.len() as u64, fem.mesh().cells.len() as u64);
@@ -165,11 +160,21 @@ fn drive(
 }
 
 fn command(dt: f64, want_snapshot: bool, stop: bool) -> StepCommand {
-    StepCommand { dt, corrections: Vec::new(), roi: None, want_interface: false, want_snapshot, stop }
+    StepCommand {
+        dt,
+        corrections: Vec::new(),
+        roi: None,
+        want_interface: false,
+        want_snapshot,
+        stop,
+    }
 }
 
 fn snapshot(state: &FemState) -> anyhow::Result<&FemSnapshot> {
-    state.snapshot.as_ref().ok_or_else(|| anyhow::anyhow!("fem-node: answered an output step without a snapshot"))
+    state
+        .snapshot
+        .as_ref()
+        .ok_or_else(|| anyhow::anyhow!("fem-node: answered an output step without a snapshot"))
 }
 
 /// One round trip, timed: the node's own compute time counts as `fem`, the rest as `messaging`.
@@ -209,7 +214,12 @@ fn plot_all(scene: &LoadedScene, out: &Path, series: &Series) -> anyhow::Result<
     for (spec, line) in scene.scene.probes.iter().zip(series) {
         let reference = spec.reference.as_ref().map(|r| (r, scene.resolve(&r.file)));
         let path = dir.join(format!("{}.svg", spec.name));
-        let result = plot_probe(&path, &spec.name, line, reference.as_ref().map(|(r, p)| (*r, p.as_path())));
+        let result = plot_probe(
+            &path,
+            &spec.name,
+            line,
+            reference.as_ref().map(|(r, p)| (*r, p.as_path())),
+        );
         if let Err(e) = result {
             tracing::warn!("plot {}: {e:#}", path.display());
         }

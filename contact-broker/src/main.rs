@@ -61,11 +61,19 @@ fn emit(value: serde_json::Value) {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::ensure!(valid_run_id(&args.run), "--run `{}`: use letters, digits, - and _ only", args.run);
+    anyhow::ensure!(
+        valid_run_id(&args.run),
+        "--run `{}`: use letters, digits, - and _ only",
+        args.run
+    );
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let (session, endpoints) = transport::open_listening(&args.listen, &args.connect, 5000)
-        .with_context(|| format!("cannot open a zenoh session (listen {:?}, connect {:?})", args.listen, args.connect))?;
+    let (session, endpoints) = transport::open_listening(&args.listen, &args.connect, 5000).with_context(|| {
+        format!(
+            "cannot open a zenoh session (listen {:?}, connect {:?})",
+            args.listen, args.connect
+        )
+    })?;
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
     let subs = transport::subscribe_fem(&session, &args.run)?;
     let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
@@ -78,7 +86,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     let wait = Duration::from_secs_f64(args.wait_nodes);
     let step_timeout = Duration::from_secs_f64(scene.scene.coupling.step_timeout);
     let mut fem = ZenohFemLink::register(&session, &args.run, subs, wait, step_timeout)?;
-    let info = RunInfo { run_id: args.run.clone(), mode: args.mode.clone(), out: args.out.clone() };
+    let info = RunInfo {
+        run_id: args.run.clone(),
+        mode: args.mode.clone(),
+        out: args.out.clone(),
+    };
     let mut last = Instant::now();
     let mut report = |p: Progress| {
         if last.elapsed() >= Duration::from_millis(200) || p.t >= p.end_time {

@@ -33,7 +33,10 @@ impl Probes {
                         .ok_or_else(|| format!("probe[{p}].solid: the FEM node has no solid `{solid}`"))?;
                     let node = nearest_node(mesh, s, point)
                         .ok_or_else(|| format!("probe[{p}].solid: solid `{solid}` has no node"))?;
-                    Resolved::Node { node, component: component.index() }
+                    Resolved::Node {
+                        node,
+                        component: component.index(),
+                    }
                 }
                 ProbeKind::Energy => {
                     let solid = match &spec.solid {
@@ -48,7 +51,10 @@ impl Probes {
                 }
             });
         }
-        Ok(Self { names: scene.probes.iter().map(|p| p.name.clone()).collect(), resolved })
+        Ok(Self {
+            names: scene.probes.iter().map(|p| p.name.clone()).collect(),
+            resolved,
+        })
     }
 
     /// Column names, in scene order.

@@ -20,7 +20,9 @@ use crate::link::{FemLink, LinkError};
 pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
     let mut config = zenoh::Config::default();
     for (k, v) in cosim_proto::session::peer_settings(listen, connect, timeout_ms) {
-        config.insert_json5(&k, &v).map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
+        config
+            .insert_json5(&k, &v)
+            .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
     }
     zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
 }
@@ -28,7 +30,11 @@ pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> a
 /// Open the broker's session. A TCP listen endpoint with port 0 gets a free port picked here (zenoh's own
 /// listing of bound locators is an unstable API), retried a few times in case another program takes it first.
 /// Returns the session and the endpoints it listens on.
-pub fn open_listening(listen: &[String], connect: &[String], timeout_ms: u64) -> anyhow::Result<(Session, Vec<String>)> {
+pub fn open_listening(
+    listen: &[String],
+    connect: &[String],
+    timeout_ms: u64,
+) -> anyhow::Result<(Session, Vec<String>)> {
     let mut last = None;
     for _ in 0..5 {
         let endpoints = listen.iter().map(|e| concrete(e)).collect::<anyhow::Result<Vec<_>>>()?;
@@ -90,7 +96,12 @@ pub struct FemSubscriptions {
 
 /// Declare the broker's subscriptions for the FEM node.
 pub fn subscribe_fem(session: &Session, run: &str) -> anyhow::Result<FemSubscriptions> {
-    let sub = |t: &str| session.declare_subscriber(key(run, t)).wait().map_err(|e| anyhow::anyhow!("{e}"));
+    let sub = |t: &str| {
+        session
+            .declare_subscriber(key(run, t))
+            .wait()
+            .map_err(|e| anyhow::anyhow!("{e}"))
+    };
     Ok(FemSubscriptions {
         mesh: sub(topic::FEM_MESH)?,
         state: sub(topic::FEM_STATE)?,
@@ -105,15 +116,19 @@ pub fn subscribe_fem(session: &Session, run: &str) -> anyhow::Result<FemSubscrip
 }
 
 fn failed(message: impl Into<String>) -> LinkError {
-    LinkError::Failed { node: "fem-node".into(), message: message.into() }
+    LinkError::Failed {
+        node: "fem-node".into(),
+        message: message.into(),
+    }
 }
 
 /// Turn a `fem/error` sample into the error the run ends with.
 fn node_error(sample: &Sample, run: &str) -> LinkError {
     match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, "fem/error") {
-        Ok(env) if env.body.status == "unstable" => {
-            LinkError::Unstable { node: "fem-node".into(), message: env.body.message }
-        }
+        Ok(env) if env.body.status == "unstable" => LinkError::Unstable {
+            node: "fem-node".into(),
+            message: env.body.message,
+        },
         Ok(env) => failed(env.body.message),
         Err(e) => failed(format!("sent an undecodable error report: {e}")),
     }
@@ -130,7 +145,11 @@ impl ZenohFemLink {
     ) -> anyhow::Result<Self> {
         let deadline = Instant::now() + wait;
         let mesh = loop {
-            if let Some(sample) = subs.mesh.recv_timeout(Duration::from_millis(50)).map_err(|e| anyhow::anyhow!("{e}"))? {
+            if let Some(sample) = subs
+                .mesh
+                .recv_timeout(Duration::from_millis(50))
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+            {
                 let env = Envelope::<FemMesh>::decode(&sample.payload().to_bytes(), run, "fem/mesh")
                     .context("fem-node registration refused")?;
                 break env.body;
@@ -185,7 +204,10 @@ impl FemLink for ZenohFemLink {
     fn exchange(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<Option<FemState>, LinkError> {
         let stop = cmd.stop;
         let bytes = Envelope::new(&self.run, step, t, cmd).encode();
-        self.command.put(bytes).wait().map_err(|e| failed(format!("cannot send step {step}: {e}")))?;
+        self.command
+            .put(bytes)
+            .wait()
+            .map_err(|e| failed(format!("cannot send step {step}: {e}")))?;
         if stop {
             return Ok(None);
         }

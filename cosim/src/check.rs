@@ -16,7 +16,11 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         (None, 0, 0)
     } else {
         let core = FemCore::new(s).with_context(|| format!("{}: building the structure", args.scene.display()))?;
-        (Some(core.mesh().dt_stable), core.mesh().nodes.len(), core.mesh().cells.len())
+        (
+            Some(core.mesh().dt_stable),
+            core.mesh().nodes.len(),
+            core.mesh().cells.len(),
+        )
     };
     let dt = s.coupling.max_dt.min(s.run.output_interval);
     let steps = (s.run.end_time / dt).ceil() as u64;
@@ -41,7 +45,10 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     println!("scene {} ({}): valid", args.scene.display(), s.run.name);
-    println!("  run: end_time {} s, output every {} s ({} frames), gravity {:?}", s.run.end_time, s.run.output_interval, frames, s.run.gravity);
+    println!(
+        "  run: end_time {} s, output every {} s ({} frames), gravity {:?}",
+        s.run.end_time, s.run.output_interval, frames, s.run.gravity
+    );
     for solid in &s.solids {
         let [nx, ny] = solid.grid_size();
         println!(

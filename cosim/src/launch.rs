@@ -25,7 +25,10 @@ pub fn find_program(name: &str) -> anyhow::Result<PathBuf> {
     if let Some(dir) = std::env::var_os("COSIM_BIN_DIR") {
         places.push(PathBuf::from(dir));
     }
-    if let Some(dir) = std::env::current_exe().ok().and_then(|e| e.parent().map(Path::to_path_buf)) {
+    if let Some(dir) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().map(Path::to_path_buf))
+    {
         places.push(dir);
     }
     if let Some(path) = std::env::var_os("PATH") {
@@ -101,7 +104,11 @@ fn parse_event(line: &str) -> Option<Event> {
     let v: serde_json::Value = serde_json::from_str(line).ok()?;
     match v.get("event")?.as_str()? {
         "listening" => Some(Event::Listening(
-            v.get("endpoints")?.as_array()?.iter().filter_map(|e| e.as_str().map(str::to_string)).collect(),
+            v.get("endpoints")?
+                .as_array()?
+                .iter()
+                .filter_map(|e| e.as_str().map(str::to_string))
+                .collect(),
         )),
         "progress" => Some(Event::Progress(Progress {
             step: v.get("step")?.as_u64()?,
@@ -162,7 +169,10 @@ pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Resul
             anyhow::bail!("contact-broker failed to start: {}", last_line(&broker_log));
         }
         if started.elapsed() > LISTEN_TIMEOUT {
-            anyhow::bail!("contact-broker did not open its session within {} s", LISTEN_TIMEOUT.as_secs());
+            anyhow::bail!(
+                "contact-broker did not open its session within {} s",
+                LISTEN_TIMEOUT.as_secs()
+            );
         }
     };
     let connect = match &args.connect {
@@ -202,14 +212,21 @@ pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Resul
     drop(fem);
 
     let summary_path = info.out.join("summary.json");
-    match std::fs::read_to_string(&summary_path).ok().and_then(|s| serde_json::from_str::<Summary>(&s).ok()) {
+    match std::fs::read_to_string(&summary_path)
+        .ok()
+        .and_then(|s| serde_json::from_str::<Summary>(&s).ok())
+    {
         Some(summary) => Ok(summary),
         None => {
             // The broker died before it could write one: write what we know.
             let message = if broker_status.success() {
                 "contact-broker exited without a summary".to_string()
             } else {
-                format!("contact-broker: {}; fem-node: {}", last_line(&broker_log), last_line(&fem_log))
+                format!(
+                    "contact-broker: {}; fem-node: {}",
+                    last_line(&broker_log),
+                    last_line(&fem_log)
+                )
             };
             let summary = failed_summary(info, message, started.elapsed().as_secs_f64());
             write_summary(&info.out, &summary)?;

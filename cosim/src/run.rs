@@ -25,7 +25,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = args.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");
     }
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
     prepare_out(&out, &scene)?;
     let info = RunInfo {
         run_id,
@@ -52,11 +55,20 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Ok(summary) => {
-            eprintln!("cosim: run {}: {} (outputs so far in {})", summary.status, summary.message, out.display());
+            eprintln!(
+                "cosim: run {}: {} (outputs so far in {})",
+                summary.status,
+                summary.message,
+                out.display()
+            );
             Ok(ExitCode::from(1))
         }
         Err(e) => {
-            eprintln!("cosim: {} (outputs so far in {})", format!("{e:#}").replace('\n', " "), out.display());
+            eprintln!(
+                "cosim: {} (outputs so far in {})",
+                format!("{e:#}").replace('\n', " "),
+                out.display()
+            );
             Ok(ExitCode::from(1))
         }
     }
@@ -95,5 +107,8 @@ fn run_in_process(
 }
 
 fn rayon_threads(n: usize) -> anyhow::Result<()> {
-    rayon::ThreadPoolBuilder::new().num_threads(n).build_global().map_err(|e| anyhow::anyhow!("--threads {n}: {e}"))
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build_global()
+        .map_err(|e| anyhow::anyhow!("--threads {n}: {e}"))
 }

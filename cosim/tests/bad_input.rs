@@ -44,8 +44,20 @@ fn write_scene(name: &str, text: &str) -> PathBuf {
 fn run_scene(name: &str, text: &str) -> (i32, String) {
     let path = write_scene(name, text);
     let out_dir = path.parent().unwrap().join("out");
-    let out = cosim_run(&["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--quiet"], LIMIT);
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
+    let out = cosim_run(
+        &[
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ],
+        LIMIT,
+    );
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 fn assert_refused(name: &str, text: &str, key: &str, words: &str) {
@@ -62,66 +74,140 @@ fn assert_refused(name: &str, text: &str, key: &str, words: &str) {
 
 #[test]
 fn unknown_key() {
-    assert_refused("unknown", &GOOD.replace("divisions = [10, 2]", "divisions = [10, 2]\ncolour = 3"), "solid[0].colour", "unknown key");
+    assert_refused(
+        "unknown",
+        &GOOD.replace("divisions = [10, 2]", "divisions = [10, 2]\ncolour = 3"),
+        "solid[0].colour",
+        "unknown key",
+    );
 }
 
 #[test]
 fn missing_key() {
-    assert_refused("missing", &GOOD.replace("end_time = 0.01\n", ""), "run.end_time", "missing key");
+    assert_refused(
+        "missing",
+        &GOOD.replace("end_time = 0.01\n", ""),
+        "run.end_time",
+        "missing key",
+    );
 }
 
 #[test]
 fn youngs_modulus_not_positive() {
-    assert_refused("young", &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = 0.0"), "solid[0].material.youngs_modulus", "positive");
-    assert_refused("young_neg", &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = -5.0"), "solid[0].material.youngs_modulus", "positive");
+    assert_refused(
+        "young",
+        &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = 0.0"),
+        "solid[0].material.youngs_modulus",
+        "positive",
+    );
+    assert_refused(
+        "young_neg",
+        &GOOD.replace("youngs_modulus = 1.0e6", "youngs_modulus = -5.0"),
+        "solid[0].material.youngs_modulus",
+        "positive",
+    );
 }
 
 #[test]
 fn poisson_ratio_out_of_range() {
-    assert_refused("nu_half", &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"), "solid[0].material.poisson_ratio", "[0, 0.5)");
-    assert_refused("nu_neg", &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = -0.1"), "solid[0].material.poisson_ratio", "[0, 0.5)");
+    assert_refused(
+        "nu_half",
+        &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.5"),
+        "solid[0].material.poisson_ratio",
+        "[0, 0.5)",
+    );
+    assert_refused(
+        "nu_neg",
+        &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = -0.1"),
+        "solid[0].material.poisson_ratio",
+        "[0, 0.5)",
+    );
 }
 
 #[test]
 fn density_not_positive() {
-    assert_refused("density", &GOOD.replace("density = 1000.0", "density = 0.0"), "solid[0].material.density", "positive");
+    assert_refused(
+        "density",
+        &GOOD.replace("density = 1000.0", "density = 0.0"),
+        "solid[0].material.density",
+        "positive",
+    );
 }
 
 #[test]
 fn zero_divisions() {
-    assert_refused("divisions", &GOOD.replace("divisions = [10, 2]", "divisions = [10, 0]"), "solid[0].divisions", "at least 1");
+    assert_refused(
+        "divisions",
+        &GOOD.replace("divisions = [10, 2]", "divisions = [10, 0]"),
+        "solid[0].divisions",
+        "at least 1",
+    );
 }
 
 #[test]
 fn fixed_box_without_nodes() {
-    let text = GOOD.replace("max = [0.001, 0.011] }", "max = [0.001, 0.011] }, { min = [0.2, 0.2], max = [0.3, 0.3] }");
+    let text = GOOD.replace(
+        "max = [0.001, 0.011] }",
+        "max = [0.001, 0.011] }, { min = [0.2, 0.2], max = [0.3, 0.3] }",
+    );
     assert_refused("fixed", &text, "solid[0].fixed[1]", "holds no node");
 }
 
 #[test]
 fn probe_names_a_missing_solid() {
-    assert_refused("probe", &GOOD.replace("solid = \"beam\"", "solid = \"gate\""), "probe[0].solid", "no solid named `gate`");
+    assert_refused(
+        "probe",
+        &GOOD.replace("solid = \"beam\"", "solid = \"gate\""),
+        "probe[0].solid",
+        "no solid named `gate`",
+    );
 }
 
 #[test]
 fn end_time_not_positive() {
-    assert_refused("end", &GOOD.replace("end_time = 0.01", "end_time = 0.0"), "run.end_time", "positive");
-    assert_refused("end_neg", &GOOD.replace("end_time = 0.01", "end_time = -1.0"), "run.end_time", "positive");
+    assert_refused(
+        "end",
+        &GOOD.replace("end_time = 0.01", "end_time = 0.0"),
+        "run.end_time",
+        "positive",
+    );
+    assert_refused(
+        "end_neg",
+        &GOOD.replace("end_time = 0.01", "end_time = -1.0"),
+        "run.end_time",
+        "positive",
+    );
 }
 
 #[test]
 fn wrong_type_and_syntax_error() {
-    assert_refused("type", &GOOD.replace("end_time = 0.01", "end_time = \"soon\""), "run.end_time", "invalid type");
+    assert_refused(
+        "type",
+        &GOOD.replace("end_time = 0.01", "end_time = \"soon\""),
+        "run.end_time",
+        "invalid type",
+    );
     assert_refused("syntax", &GOOD.replace("[run]", "[run"), "line", "");
 }
 
 #[test]
 fn bad_override_names_the_set_key() {
     let path = write_scene("set", GOOD);
-    let out = cosim_run(&["check", path.to_str().unwrap(), "--set", "solid[0].material.poisson_ratio=0.7"], LIMIT);
+    let out = cosim_run(
+        &[
+            "check",
+            path.to_str().unwrap(),
+            "--set",
+            "solid[0].material.poisson_ratio=0.7",
+        ],
+        LIMIT,
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("solid[0].material.poisson_ratio") && err.contains("[0, 0.5)"), "{err}");
+    assert!(
+        err.contains("solid[0].material.poisson_ratio") && err.contains("[0, 0.5)"),
+        "{err}"
+    );
     let out = cosim_run(&["check", path.to_str().unwrap(), "--set", "run.colour=1"], LIMIT);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -133,7 +219,10 @@ fn missing_scene_file() {
     let out = cosim_run(&["run", "/nonexistent/scene.toml", "--quiet"], LIMIT);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("/nonexistent/scene.toml") && err.contains("cannot read"), "{err}");
+    assert!(
+        err.contains("/nonexistent/scene.toml") && err.contains("cannot read"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -147,7 +236,13 @@ fn missing_fem_node_program_is_reported_within_seconds() {
     let start = Instant::now();
     let out = run_bounded(
         Command::new(dir.join("cosim"))
-            .args(["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap(), "--quiet"])
+            .args([
+                "run",
+                scene.to_str().unwrap(),
+                "--out",
+                dir.join("out").to_str().unwrap(),
+                "--quiet",
+            ])
             .env("PATH", "/usr/bin:/bin")
             .env_remove("COSIM_BIN_DIR"),
         LIMIT,
@@ -185,7 +280,16 @@ fn node_with_no_broker_on_its_run_fails_within_seconds() {
     let dir = scratch("wrongrun");
     let scene = write_scene("wrongrun_scene", GOOD);
     let mut broker = Command::new(program("contact-broker"))
-        .args(["--run", &run_id("served"), "--scene", scene.to_str().unwrap(), "--out", dir.to_str().unwrap(), "--wait-nodes", "20"])
+        .args([
+            "--run",
+            &run_id("served"),
+            "--scene",
+            scene.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+            "--wait-nodes",
+            "20",
+        ])
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
         .spawn()
@@ -193,10 +297,23 @@ fn node_with_no_broker_on_its_run_fails_within_seconds() {
     let mut line = String::new();
     std::io::BufRead::read_line(&mut std::io::BufReader::new(broker.stdout.as_mut().unwrap()), &mut line).unwrap();
     let v: serde_json::Value = serde_json::from_str(&line).unwrap();
-    let endpoint = v["endpoints"].as_array().unwrap().iter().find_map(|e| e.as_str().filter(|e| e.starts_with("tcp/"))).unwrap().to_string();
+    let endpoint = v["endpoints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find_map(|e| e.as_str().filter(|e| e.starts_with("tcp/")))
+        .unwrap()
+        .to_string();
     let start = Instant::now();
     let out = run_bounded(
-        Command::new(program("fem-node")).args(["--run", &run_id("unserved"), "--connect", &endpoint, "--timeout", "2"]),
+        Command::new(program("fem-node")).args([
+            "--run",
+            &run_id("unserved"),
+            "--connect",
+            &endpoint,
+            "--timeout",
+            "2",
+        ]),
         LIMIT,
     );
     let _ = broker.kill();

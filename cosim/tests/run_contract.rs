@@ -11,18 +11,23 @@ const LIMIT: Duration = Duration::from_secs(240);
 
 /// The shipped CSM3 scene, shortened.
 fn csm3_args<'a>(out: &'a str, run: &'a str, end: &'a str) -> Vec<&'a str> {
-    vec!["run", "scenes/csm3.toml", "--out", out, "--run-id", run, "--set", end, "--quiet"]
+    vec![
+        "run",
+        "scenes/csm3.toml",
+        "--out",
+        out,
+        "--run-id",
+        run,
+        "--set",
+        end,
+        "--quiet",
+    ]
 }
 
 fn run_ok(args: &[&str]) -> std::process::Output {
-    let out = std::process::Command::new(cosim())
-        .current_dir(root())
-        .args(args)
-        .env("COSIM_BIN_DIR", bin_dir())
-        .stdin(std::process::Stdio::null())
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped());
-    let out = run_bounded(out, LIMIT);
+    let mut cmd = std::process::Command::new(cosim());
+    cmd.current_dir(root()).args(args).env("COSIM_BIN_DIR", bin_dir());
+    let out = run_bounded(&mut cmd, LIMIT);
     assert!(
         out.status.success(),
         "cosim {args:?} failed: {}{}",
@@ -51,30 +56,45 @@ fn processes_run_writes_every_output_of_the_contract() {
     for k in ["fem", "sph", "broker", "messaging"] {
         assert!(s["timings"][k].as_f64().unwrap() >= 0.0, "timings.{k}");
     }
-    for k in ["contacts", "max_penetration", "linear_momentum_change", "angular_momentum_change"] {
+    for k in [
+        "contacts",
+        "max_penetration",
+        "linear_momentum_change",
+        "angular_momentum_change",
+    ] {
         assert!(s["contact_stats"][k].is_number(), "contact_stats.{k}");
     }
 
     let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next().unwrap(), "t,tip_ux,tip_uy,energy_total");
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
     assert_eq!(rows.len(), 21, "samples at t = 0, 0.01, ..., 0.2");
     assert_eq!(rows[0][0], 0.0);
     assert_eq!(rows[0][2], 0.0, "starts undeformed");
     assert!((rows[20][0] - 0.2).abs() < 1e-12);
-    assert!(rows[20][2] < -1e-3, "the bar sags under gravity: tip_uy = {}", rows[20][2]);
+    assert!(
+        rows[20][2] < -1e-3,
+        "the bar sags under gravity: tip_uy = {}",
+        rows[20][2]
+    );
 
     let frames = out.join("frames");
-    let vtu = std::fs::read_dir(&frames).unwrap().filter(|e| {
-        e.as_ref().unwrap().path().extension().is_some_and(|x| x == "vtu")
-    });
+    let vtu = std::fs::read_dir(&frames)
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "vtu"));
     assert_eq!(vtu.count(), 21);
     let pvd = std::fs::read_to_string(frames.join("structure.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 21);
     for p in ["tip_ux", "tip_uy", "energy_total"] {
         let plot = out.join("plots").join(format!("{p}.svg"));
-        assert!(std::fs::metadata(&plot).map(|m| m.len() > 500).unwrap_or(false), "{} missing", plot.display());
+        assert!(
+            std::fs::metadata(&plot).map(|m| m.len() > 500).unwrap_or(false),
+            "{} missing",
+            plot.display()
+        );
     }
     let svg = std::fs::read_to_string(out.join("plots/tip_uy.svg")).unwrap();
     assert!(svg.contains("Turek"), "the reference is drawn and labelled");
@@ -89,9 +109,27 @@ fn in_process_and_processes_give_identical_probes_for_any_thread_count() {
     let d = dir.join("processes-2-threads");
     let end = "run.end_time=0.3";
     run_ok(&csm3_args(a.to_str().unwrap(), &run_id("replay-a"), end));
-    run_ok(&[csm3_args(b.to_str().unwrap(), &run_id("replay-b"), end), vec!["--in-process"]].concat());
-    run_ok(&[csm3_args(c.to_str().unwrap(), &run_id("replay-c"), end), vec!["--in-process", "--threads", "1"]].concat());
-    run_ok(&[csm3_args(d.to_str().unwrap(), &run_id("replay-d"), end), vec!["--threads", "2"]].concat());
+    run_ok(
+        &[
+            csm3_args(b.to_str().unwrap(), &run_id("replay-b"), end),
+            vec!["--in-process"],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            csm3_args(c.to_str().unwrap(), &run_id("replay-c"), end),
+            vec!["--in-process", "--threads", "1"],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            csm3_args(d.to_str().unwrap(), &run_id("replay-d"), end),
+            vec!["--threads", "2"],
+        ]
+        .concat(),
+    );
     let read = |p: &std::path::Path| std::fs::read(p.join("probes.csv")).unwrap();
     let reference = read(&a);
     assert!(reference.len() > 100);
@@ -102,21 +140,74 @@ fn in_process_and_processes_give_identical_probes_for_any_thread_count() {
 }
 
 #[test]
+fn parallel_element_loop_gives_the_same_bits_on_1_and_2_threads_across_modes() {
+    // 5,000 elements: above the size where the element loop runs on the thread pool.
+    let dir = scratch("parallel");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    let common = [
+        "run",
+        "scenes/bench_5000.toml",
+        "--quiet",
+        "--set",
+        "run.end_time=0.02",
+        "--set",
+        "run.output_interval=0.005",
+    ];
+    run_ok(
+        &[
+            &common[..],
+            &[
+                "--out",
+                a.to_str().unwrap(),
+                "--threads",
+                "2",
+                "--run-id",
+                &run_id("par-a"),
+            ],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            &common[..],
+            &["--out", b.to_str().unwrap(), "--threads", "1", "--in-process"],
+        ]
+        .concat(),
+    );
+    let (pa, pb) = (
+        std::fs::read(a.join("probes.csv")).unwrap(),
+        std::fs::read(b.join("probes.csv")).unwrap(),
+    );
+    assert_eq!(pa.iter().filter(|&&c| c == b'\n').count(), 6);
+    assert_eq!(pa, pb);
+}
+
+#[test]
 fn two_runs_at_once_do_not_collide() {
     let dir = scratch("concurrent");
     let a = dir.join("a");
     let b = dir.join("b");
     let (ia, ib) = (run_id("conc-a"), run_id("conc-b"));
     let args_a = csm3_args(a.to_str().unwrap(), &ia, "run.end_time=0.1");
-    let args_b = [csm3_args(b.to_str().unwrap(), &ib, "run.end_time=0.1"), vec!["--set", "solid[0].material.youngs_modulus=2.8e6"]].concat();
+    let args_b = [
+        csm3_args(b.to_str().unwrap(), &ib, "run.end_time=0.1"),
+        vec!["--set", "solid[0].material.youngs_modulus=2.8e6"],
+    ]
+    .concat();
     let (ra, rb) = std::thread::scope(|s| {
         let ta = s.spawn(|| run_ok(&args_a));
         let tb = s.spawn(|| run_ok(&args_b));
         (ta.join().unwrap(), tb.join().unwrap())
     });
     assert!(ra.status.success() && rb.status.success());
-    let (pa, pb) = (std::fs::read(a.join("probes.csv")).unwrap(), std::fs::read(b.join("probes.csv")).unwrap());
-    assert_ne!(pa, pb, "different stiffness must give different probes: the runs crossed");
+    let (pa, pb) = (
+        std::fs::read(a.join("probes.csv")).unwrap(),
+        std::fs::read(b.join("probes.csv")).unwrap(),
+    );
+    assert_ne!(
+        pa, pb,
+        "different stiffness must give different probes: the runs crossed"
+    );
     assert_eq!(json(&a.join("summary.json"))["run_id"], ia.as_str());
     assert_eq!(json(&b.join("summary.json"))["run_id"], ib.as_str());
 }

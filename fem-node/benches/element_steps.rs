@@ -13,8 +13,16 @@ fn beam(element: ElementKind, model: MaterialModel) -> SolidSpec {
         max: [1.0, 0.05],
         divisions: [200, 25],
         element,
-        material: MaterialSpec { model, density: 1000.0, youngs_modulus: 1.4e6, poisson_ratio: 0.4 },
-        fixed: vec![cosim_proto::scene::BoxSpec { min: [-1e-9, -1.0], max: [1e-9, 1.0] }],
+        material: MaterialSpec {
+            model,
+            density: 1000.0,
+            youngs_modulus: 1.4e6,
+            poisson_ratio: 0.4,
+        },
+        fixed: vec![cosim_proto::scene::BoxSpec {
+            min: [-1e-9, -1.0],
+            max: [1e-9, 1.0],
+        }],
         damping: 0.0,
     }
 }
@@ -26,9 +34,16 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    println!("{:<8} {:<22} {:>9} {:>8} {:>16}", "element", "material", "elements", "steps", "element-steps/s");
+    println!(
+        "{:<8} {:<22} {:>9} {:>8} {:>16}",
+        "element", "material", "elements", "steps", "element-steps/s"
+    );
     for element in [ElementKind::Quad4, ElementKind::Tri3] {
-        for material in [MaterialModel::StVenantKirchhoff, MaterialModel::LinearElastic, MaterialModel::NeoHookean] {
+        for material in [
+            MaterialModel::StVenantKirchhoff,
+            MaterialModel::LinearElastic,
+            MaterialModel::NeoHookean,
+        ] {
             let spec = beam(element, material);
             let model = FemModel::from_solids(std::slice::from_ref(&spec), [0.0, -2.0]).unwrap();
             let elements = model.elements().len();
@@ -46,7 +61,14 @@ fn main() {
                     (elements * steps) as f64 / t0.elapsed().as_secs_f64()
                 })
                 .collect();
-            println!("{:<8} {:<22} {:>9} {:>8} {:>16.3e}", format!("{element:?}"), format!("{material:?}"), elements, steps, median(rates));
+            println!(
+                "{:<8} {:<22} {:>9} {:>8} {:>16.3e}",
+                format!("{element:?}"),
+                format!("{material:?}"),
+                elements,
+                steps,
+                median(rates)
+            );
         }
     }
 }

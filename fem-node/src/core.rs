@@ -26,7 +26,11 @@ impl FemCore {
         let mut interface_nodes: Vec<u32> = mesh.interface.iter().flat_map(|s| [s.a, s.b]).collect();
         interface_nodes.sort_unstable();
         interface_nodes.dedup();
-        Ok(Self { solver, mesh, interface_nodes })
+        Ok(Self {
+            solver,
+            mesh,
+            interface_nodes,
+        })
     }
 
     /// The `fem/mesh` registration message.

@@ -33,7 +33,9 @@ fn zerr(e: zenoh::Error) -> anyhow::Error {
 fn open(opts: &NodeOptions) -> anyhow::Result<Session> {
     let mut config = zenoh::Config::default();
     for (k, v) in cosim_proto::session::peer_settings(&opts.listen, &opts.connect, opts.timeout_ms) {
-        config.insert_json5(&k, &v).map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
+        config
+            .insert_json5(&k, &v)
+            .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
     }
     zenoh::open(config).wait().map_err(zerr)
 }
@@ -48,12 +50,18 @@ pub fn serve(opts: &NodeOptions) -> anyhow::Result<()> {
         .wait()
         .map_err(zerr)?;
     let report = |status: &str, message: String| {
-        let body = NodeError { status: status.into(), message };
+        let body = NodeError {
+            status: status.into(),
+            message,
+        };
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
     };
     let result = serve_session(&session, opts, &report);
     if let Err(e) = &result {
-        let status = if e.downcast_ref::<crate::error::FemError>().is_some_and(|f| f.is_unstable()) {
+        let status = if e
+            .downcast_ref::<crate::error::FemError>()
+            .is_some_and(|f| f.is_unstable())
+        {
             "unstable"
         } else {
             "failed"
@@ -67,16 +75,27 @@ pub fn serve(opts: &NodeOptions) -> anyhow::Result<()> {
 
 fn serve_session(session: &Session, opts: &NodeOptions, report: &dyn Fn(&str, String)) -> anyhow::Result<()> {
     let run = opts.run.as_str();
-    let commands = session.declare_subscriber(key(run, topic::BROKER_FEM)).wait().map_err(zerr)?;
-    let broker_alive =
-        session.liveliness().declare_subscriber(key(run, topic::BROKER_ALIVE)).history(true).wait().map_err(zerr)?;
+    let commands = session
+        .declare_subscriber(key(run, topic::BROKER_FEM))
+        .wait()
+        .map_err(zerr)?;
+    let broker_alive = session
+        .liveliness()
+        .declare_subscriber(key(run, topic::BROKER_ALIVE))
+        .history(true)
+        .wait()
+        .map_err(zerr)?;
     let state_pub = session
         .declare_publisher(key(run, topic::FEM_STATE))
         .congestion_control(CongestionControl::Block)
         .express(true)
         .wait()
         .map_err(zerr)?;
-    let _alive = session.liveliness().declare_token(key(run, topic::FEM_ALIVE)).wait().map_err(zerr)?;
+    let _alive = session
+        .liveliness()
+        .declare_token(key(run, topic::FEM_ALIVE))
+        .wait()
+        .map_err(zerr)?;
 
     let scene_text = fetch_scene(session, run, Duration::from_millis(opts.timeout_ms))?;
     let scene = cosim_proto::scene::parse("(scene from the broker)", &scene_text, &[])?;
@@ -116,12 +135,19 @@ fn serve_session(session: &Session, opts: &NodeOptions, report: &dyn Fn(&str, St
             return Ok(());
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
-        state_pub.put(Envelope::new(run, env.step, t, state).encode()).wait().map_err(zerr)?;
+        state_pub
+            .put(Envelope::new(run, env.step, t, state).encode())
+            .wait()
+            .map_err(zerr)?;
     }
 }
 
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
-    let replies = session.get(key(run, topic::SCENE)).timeout(timeout).wait().map_err(zerr)?;
+    let replies = session
+        .get(key(run, topic::SCENE))
+        .timeout(timeout)
+        .wait()
+        .map_err(zerr)?;
     match replies.recv() {
         Ok(reply) => match reply.result() {
             Ok(sample) => Ok(String::from_utf8(sample.payload().to_bytes().into_owned())?),

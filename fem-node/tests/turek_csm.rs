@@ -15,13 +15,15 @@ use cosim_proto::scene::{ElementKind, MaterialModel, SolidSpec};
 const DIVISIONS: [u32; 2] = [70, 4];
 const POINT_A: [f64; 2] = [0.6, 0.2];
 
+/// The bar exactly as the shipped scene `scenes/csm3.toml` defines it (mesh, material, clamp).
 fn bar(damping: f64) -> SolidSpec {
-    let mut s = cantilever(
-        [0.25, 0.6],
-        [0.19, 0.21],
-        DIVISIONS,
-        ElementKind::Quad4,
-        material(MaterialModel::StVenantKirchhoff, 1000.0, 1.4e6, 0.4),
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/csm3.toml");
+    let scene = cosim_proto::scene::load(&path, &[]).unwrap().scene;
+    assert_eq!(scene.run.gravity, [0.0, -2.0]);
+    let mut s = scene.solids[0].clone();
+    assert_eq!(
+        (s.divisions, s.element, s.material.model),
+        (DIVISIONS, ElementKind::Quad4, MaterialModel::StVenantKirchhoff)
     );
     s.damping = damping;
     s

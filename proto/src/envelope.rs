@@ -70,7 +70,9 @@ pub const MAX_MESSAGE_BYTES: u64 = 1 << 30;
 /// u64 length prefixes.
 fn encoder() -> impl bincode::Options {
     use bincode::Options;
-    bincode::DefaultOptions::new().with_little_endian().with_fixint_encoding()
+    bincode::DefaultOptions::new()
+        .with_little_endian()
+        .with_fixint_encoding()
 }
 
 /// The encoder's layout; no trailing bytes, and no length prefix may claim more than [`MAX_MESSAGE_BYTES`].
@@ -82,14 +84,22 @@ fn options() -> impl bincode::Options {
 impl<B: Serialize> Envelope<B> {
     /// Wrap a body for the current protocol version.
     pub fn new(run: &str, step: u64, t: f64, body: B) -> Self {
-        Self { protocol_version: PROTOCOL_VERSION, run: run.to_string(), step, t, body }
+        Self {
+            protocol_version: PROTOCOL_VERSION,
+            run: run.to_string(),
+            step,
+            t,
+            body,
+        }
     }
 
     /// Encode with the fixed bincode configuration.
     pub fn encode(&self) -> Vec<u8> {
         use bincode::Options;
         // Serialising plain data into memory with no size limit has no failure path.
-        encoder().serialize(self).expect("in-memory bincode encoding of plain data")
+        encoder()
+            .serialize(self)
+            .expect("in-memory bincode encoding of plain data")
     }
 }
 
@@ -105,11 +115,17 @@ impl<B: DeserializeOwned> Envelope<B> {
                 return Err(CodecError::Version { what, got: version });
             }
         }
-        let env: Envelope<B> = options()
-            .deserialize(bytes)
-            .map_err(|source| CodecError::Malformed { what, len: bytes.len(), source })?;
+        let env: Envelope<B> = options().deserialize(bytes).map_err(|source| CodecError::Malformed {
+            what,
+            len: bytes.len(),
+            source,
+        })?;
         if env.run != run {
-            return Err(CodecError::Run { what, got: env.run, expected: run.to_string() });
+            return Err(CodecError::Run {
+                what,
+                got: env.run,
+                expected: run.to_string(),
+            });
         }
         Ok(env)
     }
@@ -119,7 +135,11 @@ impl<B: DeserializeOwned> Envelope<B> {
         if self.step == step {
             Ok(self)
         } else {
-            Err(CodecError::Step { what, got: self.step, expected: step })
+            Err(CodecError::Step {
+                what,
+                got: self.step,
+                expected: step,
+            })
         }
     }
 }

@@ -205,7 +205,11 @@ fn default_sweeps() -> u32 {
 
 impl Default for ContactSpec {
     fn default() -> Self {
-        Self { algorithm: default_algorithm(), thickness: None, sweeps: default_sweeps() }
+        Self {
+            algorithm: default_algorithm(),
+            thickness: None,
+            sweeps: default_sweeps(),
+        }
     }
 }
 
@@ -238,7 +242,11 @@ fn default_step_timeout() -> f64 {
 
 impl Default for CouplingSpec {
     fn default() -> Self {
-        Self { max_dt: default_max_dt(), fem_cfl: default_fem_cfl(), step_timeout: default_step_timeout() }
+        Self {
+            max_dt: default_max_dt(),
+            fem_cfl: default_fem_cfl(),
+            step_timeout: default_step_timeout(),
+        }
     }
 }
 
@@ -350,7 +358,11 @@ pub struct SceneError {
 
 impl SceneError {
     fn new(file: &str, key: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { file: file.to_string(), key: key.into(), message: message.into() }
+        Self {
+            file: file.to_string(),
+            key: key.into(),
+            message: message.into(),
+        }
     }
 }
 
@@ -378,10 +390,13 @@ impl LoadedScene {
 /// Read, override and validate a scene file. `overrides` are `key.path=value` strings (`--set`).
 pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(&file, "(file)", format!("cannot read: {e}")))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", format!("cannot read: {e}")))?;
     let scene = parse(&file, &text, overrides)?;
-    Ok(LoadedScene { scene, path: path.to_path_buf() })
+    Ok(LoadedScene {
+        scene,
+        path: path.to_path_buf(),
+    })
 }
 
 /// Parse, override and validate scene text; `file` names it in errors.
@@ -423,7 +438,10 @@ fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
         }
     };
     let field_in = |prefix: &str| {
-        message.strip_prefix(prefix).and_then(|rest| rest.split('`').next()).map(str::to_string)
+        message
+            .strip_prefix(prefix)
+            .and_then(|rest| rest.split('`').next())
+            .map(str::to_string)
     };
     if let Some(field) = field_in("unknown field `") {
         return (join(&field), "unknown key".to_string());
@@ -431,7 +449,11 @@ fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
     if let Some(field) = field_in("missing field `") {
         return (join(&field), "missing key".to_string());
     }
-    let key = if parent.is_empty() { "(top level)".to_string() } else { parent };
+    let key = if parent.is_empty() {
+        "(top level)".to_string()
+    } else {
+        parent
+    };
     (key, message.replace('\n', " "))
 }
 
@@ -480,18 +502,25 @@ fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), (Strin
         }
         node = match seg {
             Segment::Key(name) => {
-                let table =
-                    node.as_table_mut().ok_or_else(|| fail(format!("`{name}` is not inside a table")))?;
+                let table = node
+                    .as_table_mut()
+                    .ok_or_else(|| fail(format!("`{name}` is not inside a table")))?;
                 if last {
                     table.insert(name, value);
                     return Ok(());
                 }
-                table.entry(name).or_insert_with(|| toml::Value::Table(toml::map::Map::new()))
+                table
+                    .entry(name)
+                    .or_insert_with(|| toml::Value::Table(toml::map::Map::new()))
             }
             Segment::Index(i) => {
-                let items = node.as_array_mut().ok_or_else(|| fail(format!("[{i}] applied to a non-array")))?;
+                let items = node
+                    .as_array_mut()
+                    .ok_or_else(|| fail(format!("[{i}] applied to a non-array")))?;
                 let len = items.len();
-                let item = items.get_mut(i).ok_or_else(|| fail(format!("index {i} out of range ({len} items)")))?;
+                let item = items
+                    .get_mut(i)
+                    .ok_or_else(|| fail(format!("index {i} out of range ({len} items)")))?;
                 if last {
                     *item = value;
                     return Ok(());
@@ -514,7 +543,9 @@ fn parse_value(raw: &str) -> toml::Value {
     struct Holder {
         v: toml::Value,
     }
-    toml::from_str::<Holder>(&format!("v = {raw}")).map(|h| h.v).unwrap_or_else(|_| toml::Value::String(raw.to_string()))
+    toml::from_str::<Holder>(&format!("v = {raw}"))
+        .map(|h| h.v)
+        .unwrap_or_else(|_| toml::Value::String(raw.to_string()))
 }
 
 type Invalid = (String, String);
@@ -528,7 +559,11 @@ fn check(ok: bool, key: impl FnOnce() -> String, message: impl FnOnce() -> Strin
 }
 
 fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
-    check(v.is_finite() && v > 0.0, || key.to_string(), || format!("must be a positive number, got {v}"))
+    check(
+        v.is_finite() && v > 0.0,
+        || key.to_string(),
+        || format!("must be a positive number, got {v}"),
+    )
 }
 
 impl Scene {
@@ -537,9 +572,18 @@ impl Scene {
         check(
             self.version == SCENE_VERSION,
             || "version".into(),
-            || format!("this build reads version {SCENE_VERSION}, the file says {}", self.version),
+            || {
+                format!(
+                    "this build reads version {SCENE_VERSION}, the file says {}",
+                    self.version
+                )
+            },
         )?;
-        check(!self.run.name.trim().is_empty(), || "run.name".into(), || "must not be empty".into())?;
+        check(
+            !self.run.name.trim().is_empty(),
+            || "run.name".into(),
+            || "must not be empty".into(),
+        )?;
         finite_positive("run.end_time", self.run.end_time)?;
         finite_positive("run.output_interval", self.run.output_interval)?;
         check(
@@ -558,32 +602,52 @@ impl Scene {
         if let Some(t) = self.contact.thickness {
             finite_positive("contact.thickness", t)?;
         }
-        check(self.contact.sweeps >= 1, || "contact.sweeps".into(), || "must be at least 1".into())?;
+        check(
+            self.contact.sweeps >= 1,
+            || "contact.sweeps".into(),
+            || "must be at least 1".into(),
+        )?;
         for (s, solid) in self.solids.iter().enumerate() {
             self.validate_solid(s, solid)?;
         }
         let mut names: Vec<&str> = Vec::new();
         for (p, probe) in self.probes.iter().enumerate() {
             let key = |k: &str| format!("probe[{p}].{k}");
-            check(!probe.name.trim().is_empty() && !probe.name.contains(','), || key("name"), || {
-                "must be non-empty and contain no comma".into()
-            })?;
-            check(!names.contains(&probe.name.as_str()), || key("name"), || {
-                format!("`{}` is used by another probe", probe.name)
-            })?;
+            check(
+                !probe.name.trim().is_empty() && !probe.name.contains(','),
+                || key("name"),
+                || "must be non-empty and contain no comma".into(),
+            )?;
+            check(
+                !names.contains(&probe.name.as_str()),
+                || key("name"),
+                || format!("`{}` is used by another probe", probe.name),
+            )?;
             names.push(&probe.name);
             if let Some(name) = &probe.solid {
-                check(self.solids.iter().any(|s| &s.name == name), || key("solid"), || {
-                    format!("no solid named `{name}` (solids: {})", self.solid_names())
-                })?;
+                check(
+                    self.solids.iter().any(|s| &s.name == name),
+                    || key("solid"),
+                    || format!("no solid named `{name}` (solids: {})", self.solid_names()),
+                )?;
             }
             match probe.kind {
                 ProbeKind::NodeDisplacement => {
-                    check(probe.solid.is_some(), || key("solid"), || "missing key (node_displacement)".into())?;
-                    check(probe.point.is_some(), || key("point"), || "missing key (node_displacement)".into())?;
-                    check(probe.component.is_some(), || key("component"), || {
-                        "missing key (node_displacement)".into()
-                    })?;
+                    check(
+                        probe.solid.is_some(),
+                        || key("solid"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
+                    check(
+                        probe.point.is_some(),
+                        || key("point"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
+                    check(
+                        probe.component.is_some(),
+                        || key("component"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
                 }
                 ProbeKind::Energy => {
                     check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
@@ -600,12 +664,20 @@ impl Scene {
         if self.solids.is_empty() {
             return "none".into();
         }
-        self.solids.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+        self.solids
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     fn validate_solid(&self, s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
         let key = |k: &str| format!("solid[{s}].{k}");
-        check(!solid.name.trim().is_empty(), || key("name"), || "must not be empty".into())?;
+        check(
+            !solid.name.trim().is_empty(),
+            || key("name"),
+            || "must not be empty".into(),
+        )?;
         check(
             !self.solids[..s].iter().any(|o| o.name == solid.name),
             || key("name"),
@@ -615,11 +687,18 @@ impl Scene {
             check(
                 solid.min[k].is_finite() && solid.max[k].is_finite() && solid.max[k] > solid.min[k],
                 || key("max"),
-                || format!("must be greater than min in every component, got min {:?} max {:?}", solid.min, solid.max),
+                || {
+                    format!(
+                        "must be greater than min in every component, got min {:?} max {:?}",
+                        solid.min, solid.max
+                    )
+                },
             )?;
-            check(solid.divisions[k] > 0, || key("divisions"), || {
-                format!("must be at least 1 in every component, got {:?}", solid.divisions)
-            })?;
+            check(
+                solid.divisions[k] > 0,
+                || key("divisions"),
+                || format!("must be at least 1 in every component, got {:?}", solid.divisions),
+            )?;
         }
         let m = &solid.material;
         finite_positive(&key("material.density"), m.density)?;
@@ -629,14 +708,18 @@ impl Scene {
             || key("material.poisson_ratio"),
             || format!("must be in [0, 0.5), got {}", m.poisson_ratio),
         )?;
-        check(solid.damping.is_finite() && solid.damping >= 0.0, || key("damping"), || {
-            format!("must be zero or positive, got {}", solid.damping)
-        })?;
+        check(
+            solid.damping.is_finite() && solid.damping >= 0.0,
+            || key("damping"),
+            || format!("must be zero or positive, got {}", solid.damping),
+        )?;
         let nodes = solid.grid_nodes();
         for (f, b) in solid.fixed.iter().enumerate() {
-            check(nodes.iter().any(|&p| b.contains(p)), || key(&format!("fixed[{f}]")), || {
-                format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max)
-            })?;
+            check(
+                nodes.iter().any(|&p| b.contains(p)),
+                || key(&format!("fixed[{f}]")),
+                || format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max),
+            )?;
         }
         Ok(())
     }

@@ -1,9 +1,7 @@
 //! How the codec refuses a message (`docs/PROTOCOL.md` §7) and how it behaves on arbitrary input.
 
 use cosim_proto::keys::{key, topic, valid_run_id};
-use cosim_proto::messages::{
-    Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand,
-};
+use cosim_proto::messages::{Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand};
 use cosim_proto::{CodecError, Envelope, PROTOCOL_VERSION};
 use proptest::prelude::*;
 
@@ -51,9 +49,7 @@ fn fem_state() -> Envelope<FemState> {
 
 fn assert_malformed<B: std::fmt::Debug>(result: Result<Envelope<B>, CodecError>, len: usize) {
     match result {
-        Err(CodecError::Malformed {
-            what, len: got_len, ..
-        }) => {
+        Err(CodecError::Malformed { what, len: got_len, .. }) => {
             assert_eq!(what, "test");
             assert_eq!(got_len, len);
         }
@@ -100,21 +96,14 @@ fn another_run_is_refused_with_run() {
     let bytes = step_command().encode();
     let err = Envelope::<StepCommand>::decode(&bytes, "r2", "test").unwrap_err();
     match &err {
-        CodecError::Run {
-            what,
-            got,
-            expected,
-        } => {
+        CodecError::Run { what, got, expected } => {
             assert_eq!(*what, "test");
             assert_eq!(got, "r1");
             assert_eq!(expected, "r2");
         }
         other => panic!("expected CodecError::Run, got {other:?}"),
     }
-    assert_eq!(
-        err.to_string(),
-        "test message belongs to run `r1`, not `r2`"
-    );
+    assert_eq!(err.to_string(), "test message belongs to run `r1`, not `r2`");
 }
 
 #[test]
@@ -132,10 +121,7 @@ fn another_step_is_refused_with_step() {
         ),
         "{err:?}"
     );
-    assert_eq!(
-        err.to_string(),
-        "test message is for step 3, expected step 4"
-    );
+    assert_eq!(err.to_string(), "test message is for step 3, expected step 4");
     assert_eq!(env.clone().expect_step(3, "test").unwrap(), env);
 }
 
@@ -153,17 +139,11 @@ fn trailing_bytes_are_malformed() {
 fn every_truncation_is_malformed() {
     let full = fem_state().encode();
     for cut in 0..full.len() {
-        assert_malformed(
-            Envelope::<FemState>::decode(&full[..cut], "r1", "test"),
-            cut,
-        );
+        assert_malformed(Envelope::<FemState>::decode(&full[..cut], "r1", "test"), cut);
     }
     let full = step_command().encode();
     for cut in 0..full.len() {
-        assert_malformed(
-            Envelope::<StepCommand>::decode(&full[..cut], "r1", "test"),
-            cut,
-        );
+        assert_malformed(Envelope::<StepCommand>::decode(&full[..cut], "r1", "test"), cut);
     }
 }
 
@@ -255,19 +235,14 @@ fn step_command_strategy() -> impl Strategy<Value = StepCommand> {
         prop::option::of([finite(), finite(), finite(), finite()]),
         any::<(bool, bool, bool)>(),
     )
-        .prop_map(
-            |(dt, corr, roi, (want_interface, want_snapshot, stop))| StepCommand {
-                dt,
-                corrections: corr
-                    .into_iter()
-                    .map(|(id, dx, dv)| Correction { id, dx, dv })
-                    .collect(),
-                roi,
-                want_interface,
-                want_snapshot,
-                stop,
-            },
-        )
+        .prop_map(|(dt, corr, roi, (want_interface, want_snapshot, stop))| StepCommand {
+            dt,
+            corrections: corr.into_iter().map(|(id, dx, dv)| Correction { id, dx, dv }).collect(),
+            roi,
+            want_interface,
+            want_snapshot,
+            stop,
+        })
 }
 
 fn fem_mesh_strategy() -> impl Strategy<Value = FemMesh> {
@@ -279,19 +254,17 @@ fn fem_mesh_strategy() -> impl Strategy<Value = FemMesh> {
         prop::collection::vec((any::<u32>(), any::<u32>()), 0..4),
         finite(),
     )
-        .prop_map(
-            |(solid_names, nodes, masses, cells, segs, dt_stable)| FemMesh {
-                node_solid: vec![0; nodes.len()],
-                cell_solid: vec![1; cells.len()],
-                interface: segs.into_iter().map(|(a, b)| Segment { a, b }).collect(),
-                fixed: vec![2; masses.len()],
-                solid_names,
-                nodes,
-                masses,
-                cells,
-                dt_stable,
-            },
-        )
+        .prop_map(|(solid_names, nodes, masses, cells, segs, dt_stable)| FemMesh {
+            node_solid: vec![0; nodes.len()],
+            cell_solid: vec![1; cells.len()],
+            interface: segs.into_iter().map(|(a, b)| Segment { a, b }).collect(),
+            fixed: vec![2; masses.len()],
+            solid_names,
+            nodes,
+            masses,
+            cells,
+            dt_stable,
+        })
 }
 
 proptest! {

@@ -11,9 +11,7 @@
 
 use std::fmt::Debug;
 
-use cosim_proto::messages::{
-    Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand,
-};
+use cosim_proto::messages::{Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand};
 use cosim_proto::{Envelope, PROTOCOL_VERSION};
 use serde::{de::DeserializeOwned, Serialize};
 
@@ -32,11 +30,7 @@ fn hex(text: &str) -> Vec<u8> {
 }
 
 fn to_hex(bytes: &[u8]) -> String {
-    bytes
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect::<Vec<_>>()
-        .join(" ")
+    bytes.iter().map(|b| format!("{b:02x}")).collect::<Vec<_>>().join(" ")
 }
 
 /// Encode `env`, compare with `expected_hex`, decode the expected bytes back and compare with `env`.
@@ -53,8 +47,7 @@ where
         to_hex(&encoded),
         to_hex(&expected)
     );
-    let decoded =
-        Envelope::<B>::decode(&expected, &env.run, "golden").expect("golden bytes decode");
+    let decoded = Envelope::<B>::decode(&expected, &env.run, "golden").expect("golden bytes decode");
     assert_eq!(&decoded, env);
 }
 
@@ -191,11 +184,7 @@ fn fem_mesh_golden() {
             node_solid: vec![0, 0, 0],
             cells: vec![vec![0, 1, 2]],
             cell_solid: vec![0],
-            interface: vec![
-                Segment { a: 0, b: 1 },
-                Segment { a: 1, b: 2 },
-                Segment { a: 2, b: 0 },
-            ],
+            interface: vec![Segment { a: 0, b: 1 }, Segment { a: 1, b: 2 }, Segment { a: 2, b: 0 }],
             fixed: vec![0],
             dt_stable: 0.0625,
         },

@@ -48,7 +48,10 @@ fn defaults_and_overrides_by_index_name_and_single_item() {
 #[test]
 fn errors_name_file_and_key() {
     assert_eq!(err(SCENE, &["run.speed=3"]), "f.toml: run.speed: unknown key");
-    assert_eq!(err(&SCENE.replace("name = \"s\"\n", ""), &[]), "f.toml: run.name: missing key");
+    assert_eq!(
+        err(&SCENE.replace("name = \"s\"\n", ""), &[]),
+        "f.toml: run.name: missing key"
+    );
     assert_eq!(
         err(SCENE, &["solid[0].material.poisson_ratio=0.5"]),
         "f.toml: solid[0].material.poisson_ratio: must be in [0, 0.5), got 0.5"

@@ -93,7 +93,6 @@ impl ProbeCsv {
 }
 
 fn format_row(t: f64, values: &[f64]) -> String {
-    use std::fmt::Write as _;
     let mut line = String::with_capacity(24 * (values.len() + 1));
     write_number(&mut line, t);
     for &v in values {
@@ -109,7 +108,11 @@ fn format_row(t: f64, values: &[f64]) -> String {
 fn write_number(line: &mut String, v: f64) {
     use std::fmt::Write as _;
     let plain = v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs());
-    let _ = if plain { write!(line, "{v}") } else { write!(line, "{v:e}") };
+    let _ = if plain {
+        write!(line, "{v}")
+    } else {
+        write!(line, "{v:e}")
+    };
 }
 
 #[cfg(test)]

@@ -18,7 +18,11 @@ pub fn bin_dir() -> PathBuf {
 /// A sibling program, which must have been built (`cargo build --release` before `cargo test --release`).
 pub fn program(name: &str) -> PathBuf {
     let p = bin_dir().join(name);
-    assert!(p.is_file(), "{} is missing: run `cargo build --release` before the tests", p.display());
+    assert!(
+        p.is_file(),
+        "{} is missing: run `cargo build --release` before the tests",
+        p.display()
+    );
     p
 }
 
@@ -37,7 +41,12 @@ pub fn scratch(name: &str) -> PathBuf {
 
 /// Run a command, killing it after `limit`; panics on a timeout so no test can hang.
 pub fn run_bounded(cmd: &mut Command, limit: Duration) -> Output {
-    let mut child = cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
     let start = Instant::now();
     loop {
         if child.try_wait().unwrap().is_some() {
@@ -67,11 +76,14 @@ pub fn run_id(name: &str) -> String {
 
 /// Read a JSON file.
 pub fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
-        .unwrap()
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))).unwrap()
 }
 
 /// A free TCP port on loopback (nobody listens on it once this returns).
 pub fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
 }
