@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use anyhow::Context;
+
 use cosim_proto::messages::{FemSnapshot, FemState, StepCommand};
-use cosim_proto::scene::LoadedScene;
+use cosim_proto::scene::{LoadedScene, SceneError};
 
 use crate::link::{FemLink, LinkError};
 use crate::output::{plot_probe, FrameWriter, ProbeCsv};
@@ -41,6 +43,35 @@ pub struct Outcome {
     pub summary: Summary,
     /// Set when the run did not finish.
     pub error: Option<anyhow::Error>,
+}
+
+/// What this build can run: structure-only scenes. The fluid node is not wired into the coordinator yet, so a
+/// scene with water or walls is refused up front with the key that asks for it.
+pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
+    let file = scene.path.display().to_string();
+    let refuse = |key: &str, message: &str| {
+        Err(SceneError {
+            file: file.clone(),
+            key: key.into(),
+            message: message.into(),
+        })
+    };
+    if scene.scene.fluid.is_some() {
+        return refuse(
+            "fluid",
+            "this build runs structure-only scenes; the SPH node is not part of the run yet",
+        );
+    }
+    if !scene.scene.walls.is_empty() {
+        return refuse(
+            "wall",
+            "rigid walls belong to the SPH node, which this build does not run yet",
+        );
+    }
+    if scene.scene.solids.is_empty() {
+        return refuse("solid", "nothing to run: the scene has no [[solid]]");
+    }
+    Ok(())
 }
 
 /// Steps closer than this fraction of `max_dt` to an output time land on it.
@@ -187,7 +218,9 @@ fn exchange(
 ) -> anyhow::Result<FemState> {
     let stop = cmd.stop;
     let t0 = Instant::now();
-    let reply = fem.exchange(step, t, cmd)?;
+    let reply = fem
+        .exchange(step, t, cmd)
+        .with_context(|| format!("coupling step {step} from t = {t} s"))?;
     let wall = t0.elapsed().as_secs_f64();
     match reply {
         Some(state) => {

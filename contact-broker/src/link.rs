@@ -9,7 +9,7 @@ use cosim_proto::messages::{FemMesh, FemState, StepCommand};
 #[derive(Debug, thiserror::Error)]
 pub enum LinkError {
     /// The node reported a numerical blow-up.
-    #[error("{node}: unstable: {message}")]
+    #[error("{node}: {message}")]
     Unstable {
         /// Node name.
         node: String,

@@ -67,6 +67,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         args.run
     );
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
+    coordinator::check_supported(&scene)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let (session, endpoints) = transport::open_listening(&args.listen, &args.connect, 5000).with_context(|| {
         format!(

@@ -17,6 +17,7 @@ use crate::progress::Bar;
 /// Run a scene; `Err` only for bad input (exit 2), a failed run is exit 1 with one line on stderr.
 pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let scene = scene::load(&args.scene, &args.set)?;
+    coordinator::check_supported(&scene)?;
     let run_id = match &args.run_id {
         Some(id) if valid_run_id(id) => id.clone(),
         Some(id) => anyhow::bail!("--run-id `{id}`: use 1–64 letters, digits, - and _"),

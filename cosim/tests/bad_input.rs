@@ -323,3 +323,21 @@ fn node_with_no_broker_on_its_run_fails_within_seconds() {
     assert!(err.contains("no broker of run"), "{err}");
     assert!(start.elapsed() < Duration::from_secs(10), "took {:?}", start.elapsed());
 }
+
+#[test]
+fn fluid_scene_is_refused_by_this_build_naming_the_key() {
+    let text = GOOD.replace(
+        "[[solid]]",
+        "[fluid]\ndensity = 1000.0\nspacing = 0.01\n[[fluid.block]]\nmin = [0.0, 0.02]\nmax = [0.1, 0.1]\n\n[[solid]]",
+    );
+    assert_refused("fluid", &text, "fluid", "structure-only");
+}
+
+#[test]
+fn fluid_block_smaller_than_the_spacing() {
+    let text = GOOD.replace(
+        "[[solid]]",
+        "[fluid]\ndensity = 1000.0\nspacing = 0.01\n[[fluid.block]]\nmin = [0.0, 0.02]\nmax = [0.005, 0.1]\n\n[[solid]]",
+    );
+    assert_refused("fluid_block", &text, "fluid.block[0]", "holds no particle");
+}

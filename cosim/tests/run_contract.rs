@@ -225,3 +225,44 @@ fn check_prints_what_would_run() {
     assert_eq!(doc["coupling_steps"].as_u64().unwrap(), 5000);
     assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn a_blow_up_ends_the_run_unstable_and_keeps_what_was_computed() {
+    // A soft bar under a huge load: its elements invert within a few steps.
+    let dir = scratch("unstable");
+    let out = dir.join("out");
+    let mut cmd = std::process::Command::new(cosim());
+    cmd.current_dir(root()).env("COSIM_BIN_DIR", bin_dir()).args([
+        "run",
+        "scenes/csm3.toml",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--run-id",
+        &run_id("unstable"),
+        "--set",
+        "run.gravity=[0.0, -1.0e5]",
+        "--set",
+        "run.end_time=1.0",
+    ]);
+    let res = run_bounded(&mut cmd, LIMIT);
+    let err = String::from_utf8_lossy(&res.stderr);
+    assert_eq!(res.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("unstable") && err.contains("element"), "{err}");
+    let s = json(&out.join("summary.json"));
+    assert_eq!(s["status"], "unstable");
+    assert!(s["sim_time"].as_f64().unwrap() < 1.0);
+    // The samples taken before the blow-up are kept, and they are finite.
+    let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let rows = csv.lines().skip(1).count();
+    assert!(
+        rows >= 1 && rows as u64 == s["samples"].as_u64().unwrap(),
+        "{rows} rows"
+    );
+    assert!(csv
+        .lines()
+        .skip(1)
+        .all(|l| l.split(',').all(|v| v.parse::<f64>().unwrap().is_finite())));
+    assert!(out.join("frames/structure.pvd").is_file());
+}

@@ -20,7 +20,7 @@ pub enum FemError {
         message: String,
     },
     /// The solution blew up: an inverted element (J ≤ 0) or a non-finite value.
-    #[error("unstable at step {step}, element {element}: {reason}")]
+    #[error("unstable at FEM sub-step {step}, element {element}: {reason}")]
     Unstable {
         /// Number of the sub-step being taken when it failed (`FemState::step + 1`, or the current step when
         /// the failure is found outside a step).

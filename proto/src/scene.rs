@@ -17,6 +17,12 @@ pub struct Scene {
     pub version: u32,
     /// Run-wide settings.
     pub run: RunSpec,
+    /// Water (`[fluid]`); absent for a structure-only run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fluid: Option<FluidSpec>,
+    /// Rigid walls (`[[wall]]`), filled with fixed boundary particles.
+    #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<BoxSpec>,
     /// Elastic structures (`[[solid]]`).
     #[serde(default, rename = "solid", skip_serializing_if = "Vec::is_empty")]
     pub solids: Vec<SolidSpec>,
@@ -48,6 +54,102 @@ pub struct RunSpec {
 
 fn default_gravity() -> [f64; 2] {
     [0.0, -9.81]
+}
+
+/// Fluid solver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FluidSolver {
+    /// Weakly compressible SPH (`DESIGN.md` §4.2).
+    Wcsph,
+    /// Incompressible SPH, projection method (§4.3).
+    Isph,
+}
+
+/// Density filter (§4.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DensityFilter {
+    /// None.
+    None,
+    /// Shepard filter.
+    Shepard,
+    /// First-order moving least squares.
+    Mls,
+}
+
+/// `[fluid]` (`DESIGN.md` §5.1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidSpec {
+    /// Solver.
+    #[serde(default = "default_fluid_solver")]
+    pub solver: FluidSolver,
+    /// Rest density ρ0 [kg/m³].
+    pub density: f64,
+    /// Kinematic viscosity ν [m²/s]; 0 disables the viscous term.
+    #[serde(default)]
+    pub kinematic_viscosity: f64,
+    /// Particle spacing Δx [m].
+    pub spacing: f64,
+    /// h = smoothing_ratio · spacing.
+    #[serde(default = "default_smoothing_ratio")]
+    pub smoothing_ratio: f64,
+    /// Speed of sound c0 [m/s] (WCSPH); default 10·sqrt(2 g H) with H the highest fluid block top.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sound_speed: Option<f64>,
+    /// α of the Monaghan artificial viscosity, Eq. (11).
+    #[serde(default = "default_artificial_viscosity")]
+    pub artificial_viscosity: f64,
+    /// Density filter; default Shepard for WCSPH, none for ISPH.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_filter: Option<DensityFilter>,
+    /// Steps between density filter passes.
+    #[serde(default = "default_filter_interval")]
+    pub density_filter_interval: u32,
+    /// XSPH ε; 0 disables.
+    #[serde(default = "default_xsph")]
+    pub xsph: f64,
+    /// APD β; 0 disables.
+    #[serde(default = "default_apd")]
+    pub apd: f64,
+    /// Regions filled with particles at rest (`[[fluid.block]]`).
+    #[serde(rename = "block")]
+    pub blocks: Vec<BoxSpec>,
+}
+
+fn default_fluid_solver() -> FluidSolver {
+    FluidSolver::Wcsph
+}
+
+fn default_smoothing_ratio() -> f64 {
+    1.3
+}
+
+fn default_artificial_viscosity() -> f64 {
+    0.01
+}
+
+fn default_filter_interval() -> u32 {
+    20
+}
+
+fn default_xsph() -> f64 {
+    0.5
+}
+
+fn default_apd() -> f64 {
+    0.04
+}
+
+impl FluidSpec {
+    /// The density filter in force (the per-solver default of §4.4 when the scene names none).
+    pub fn density_filter(&self) -> DensityFilter {
+        self.density_filter.unwrap_or(match self.solver {
+            FluidSolver::Wcsph => DensityFilter::Shepard,
+            FluidSolver::Isph => DensityFilter::None,
+        })
+    }
 }
 
 /// Finite element type.
@@ -566,6 +668,73 @@ fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
     )
 }
 
+/// The fluid section: positive sizes, a sensible smoothing ratio, blocks that hold particles and stay out of walls.
+fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec]) -> Result<(), Invalid> {
+    finite_positive("fluid.density", f.density)?;
+    finite_positive("fluid.spacing", f.spacing)?;
+    check(
+        f.kinematic_viscosity.is_finite() && f.kinematic_viscosity >= 0.0,
+        || "fluid.kinematic_viscosity".into(),
+        || format!("must be zero or positive, got {}", f.kinematic_viscosity),
+    )?;
+    check(
+        (1.0..=2.0).contains(&f.smoothing_ratio),
+        || "fluid.smoothing_ratio".into(),
+        || format!("must be in [1, 2] (h = ratio x spacing), got {}", f.smoothing_ratio),
+    )?;
+    if let Some(c) = f.sound_speed {
+        finite_positive("fluid.sound_speed", c)?;
+    }
+    check(
+        f.artificial_viscosity.is_finite() && f.artificial_viscosity >= 0.0,
+        || "fluid.artificial_viscosity".into(),
+        || format!("must be zero or positive, got {}", f.artificial_viscosity),
+    )?;
+    check(
+        f.density_filter_interval >= 1,
+        || "fluid.density_filter_interval".into(),
+        || "must be at least 1".into(),
+    )?;
+    check(
+        f.xsph.is_finite() && (0.0..=1.0).contains(&f.xsph),
+        || "fluid.xsph".into(),
+        || format!("must be in [0, 1], got {}", f.xsph),
+    )?;
+    check(
+        f.apd.is_finite() && (0.0..=1.0).contains(&f.apd),
+        || "fluid.apd".into(),
+        || format!("must be in [0, 1], got {}", f.apd),
+    )?;
+    check(
+        !f.blocks.is_empty(),
+        || "fluid.block".into(),
+        || "at least one [[fluid.block]] is needed".into(),
+    )?;
+    for (b, block) in f.blocks.iter().enumerate() {
+        let key = || format!("fluid.block[{b}]");
+        check(
+            (0..2).all(|k| block.min[k].is_finite() && block.max[k].is_finite()),
+            key,
+            || "corners must be finite".into(),
+        )?;
+        check((0..2).all(|k| block.max[k] - block.min[k] >= f.spacing), key, || {
+            format!(
+                "holds no particle: min {:?} max {:?} is narrower than the spacing {}",
+                block.min, block.max, f.spacing
+            )
+        })?;
+        for (w, wall) in walls.iter().enumerate() {
+            // Overlap of more than half a spacing in both directions: particles would sit inside the wall.
+            let overlap =
+                (0..2).all(|k| block.max[k].min(wall.max[k]) - block.min[k].max(wall.min[k]) > 0.5 * f.spacing);
+            check(!overlap, key, || {
+                format!("overlaps wall[{w}] (min {:?} max {:?})", wall.min, wall.max)
+            })?;
+        }
+    }
+    Ok(())
+}
+
 impl Scene {
     /// Checks every value a solver relies on. Returns the dotted key and the problem.
     pub fn validate(&self) -> Result<(), (String, String)> {
@@ -607,6 +776,21 @@ impl Scene {
             || "contact.sweeps".into(),
             || "must be at least 1".into(),
         )?;
+        if let Some(fluid) = &self.fluid {
+            validate_fluid(fluid, &self.walls)?;
+        }
+        for (w, wall) in self.walls.iter().enumerate() {
+            check(
+                (0..2).all(|k| wall.min[k].is_finite() && wall.max[k].is_finite() && wall.max[k] > wall.min[k]),
+                || format!("wall[{w}].max"),
+                || {
+                    format!(
+                        "must be greater than min in every component, got min {:?} max {:?}",
+                        wall.min, wall.max
+                    )
+                },
+            )?;
+        }
         for (s, solid) in self.solids.iter().enumerate() {
             self.validate_solid(s, solid)?;
         }
