@@ -1,5 +1,5 @@
 //! The step coordinator (`DESIGN.md` §3): fixes each coupling step, holds the step barrier, samples probes and
-//! writes the outputs. It talks to the solvers only through [`FemLink`], so it runs the same in-process and
+//! writes the outputs. It talks to the solvers only through [`crate::link::NodeLink`], so it runs the same in-process and
 //! distributed.
 
 use std::path::{Path, PathBuf};
@@ -7,11 +7,11 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use cosim_proto::messages::{FemSnapshot, FemState, StepCommand};
+use cosim_proto::messages::{FemState, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{LoadedScene, SceneError};
 
-use crate::link::{FemLink, LinkError};
-use crate::output::{plot_probe, FrameWriter, ProbeCsv};
+use crate::link::{FemLink, LinkError, Reply, SphLink};
+use crate::output::{plot_probe, FrameWriter, PointField, ProbeCsv};
 use crate::probes::Probes;
 use crate::summary::{ContactStats, Summary, Timings};
 
@@ -45,31 +45,28 @@ pub struct Outcome {
     pub error: Option<anyhow::Error>,
 }
 
-/// What this build can run: structure-only scenes. The fluid node is not wired into the coordinator yet, so a
-/// scene with water or walls is refused up front with the key that asks for it.
+/// What this build can run: structure-only and fluid-only scenes. Contact between the two is not wired into the
+/// coordinator yet, so a scene with both is refused up front with the key that asks for it.
 pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
-    let file = scene.path.display().to_string();
     let refuse = |key: &str, message: &str| {
         Err(SceneError {
-            file: file.clone(),
+            file: scene.path.display().to_string(),
             key: key.into(),
             message: message.into(),
         })
     };
-    if scene.scene.fluid.is_some() {
+    let s = &scene.scene;
+    if s.fluid.is_some() && !s.solids.is_empty() {
         return refuse(
-            "fluid",
-            "this build runs structure-only scenes; the SPH node is not part of the run yet",
+            "solid",
+            "this build runs structure-only or fluid-only scenes; fluid-structure contact is not part of the run yet",
         );
     }
-    if !scene.scene.walls.is_empty() {
-        return refuse(
-            "wall",
-            "rigid walls belong to the SPH node, which this build does not run yet",
-        );
+    if s.fluid.is_none() && !s.walls.is_empty() {
+        return refuse("wall", "walls hold water: a scene with [[wall]] needs a [fluid]");
     }
-    if scene.scene.solids.is_empty() {
-        return refuse("solid", "nothing to run: the scene has no [[solid]]");
+    if s.fluid.is_none() && s.solids.is_empty() {
+        return refuse("solid", "nothing to run: the scene has no [[solid]] and no [fluid]");
     }
     Ok(())
 }
@@ -77,11 +74,22 @@ pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
 /// Steps closer than this fraction of `max_dt` to an output time land on it.
 const LANDING: f64 = 1e-9;
 
+/// The nodes of a run; a scene without fluid has no fluid node and vice versa.
+pub struct Nodes<'a> {
+    /// The structure node.
+    pub fem: Option<&'a mut FemLink>,
+    /// The fluid node.
+    pub sph: Option<&'a mut SphLink>,
+}
+
 /// Run a scene to its end time (or to the first failure) and write every output.
-pub fn run(scene: &LoadedScene, fem: &mut dyn FemLink, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
+pub fn run(scene: &LoadedScene, mut nodes: Nodes<'_>, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
     let started = Instant::now();
     let s = &scene.scene;
-    let (fem_nodes, fem_elements) = (fem.mesh().nodes.len() as u64, fem.mesh().cells.len() as u64);
+    let (fem_nodes, fem_elements) = nodes
+        .fem
+        .as_ref()
+        .map_or((0, 0), |f| (f.setup().nodes.len() as u64, f.setup().cells.len() as u64));
     let mut summary = Summary {
         status: "ok".into(),
         message: String::new(),
@@ -91,10 +99,13 @@ pub fn run(scene: &LoadedScene, fem: &mut dyn FemLink, info: &RunInfo, progress:
         fem_substeps: 0,
         sim_time: 0.0,
         wall_seconds: 0.0,
-        particles: 0,
+        particles: nodes.sph.as_ref().map_or(0, |n| u64::from(n.setup().particles)),
         fem_nodes,
         fem_elements,
-        solver: "none".into(),
+        solver: s
+            .fluid
+            .as_ref()
+            .map_or("none".into(), |f| format!("{:?}", f.solver).to_lowercase()),
         contact: "none".into(),
         mode: info.mode.clone(),
         frames: 0,
@@ -103,7 +114,7 @@ pub fn run(scene: &LoadedScene, fem: &mut dyn FemLink, info: &RunInfo, progress:
         contact_stats: ContactStats::default(),
     };
     let mut series = Vec::new();
-    let error = drive(scene, fem, info, progress, &mut summary, &mut series).err();
+    let error = drive(scene, &mut nodes, info, progress, &mut summary, &mut series).err();
     // Whatever happened, the probes computed so far are plotted and the summary is written.
     let t_plot = Instant::now();
     if let Err(e) = plot_all(scene, &info.out, &series) {
@@ -129,64 +140,101 @@ pub fn run(scene: &LoadedScene, fem: &mut dyn FemLink, info: &RunInfo, progress:
 /// Probe values over time, per probe.
 type Series = Vec<Vec<(f64, f64)>>;
 
+/// The answers of one coupling step.
+struct Round {
+    fem: Option<FemState>,
+    sph: Option<SphState>,
+}
+
 fn drive(
     scene: &LoadedScene,
-    fem: &mut dyn FemLink,
+    nodes: &mut Nodes<'_>,
     info: &RunInfo,
     progress: &mut dyn FnMut(Progress),
     summary: &mut Summary,
     series: &mut Series,
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
-    let probes = Probes::resolve(s, fem.mesh()).map_err(anyhow::Error::msg)?;
+    let mut probes = Probes::resolve(
+        s,
+        nodes.fem.as_ref().map(|f| f.setup()),
+        nodes.sph.as_ref().map(|n| n.setup()),
+    )
+    .map_err(anyhow::Error::msg)?;
     *series = vec![Vec::new(); probes.names().len()];
     let mut frames = FrameWriter::new(&info.out)?;
     let mut csv = ProbeCsv::create(&info.out.join("probes.csv"), probes.names())?;
     let interval = s.run.output_interval;
     let end = s.run.end_time;
-    let mut sample = |t: f64, snap: &FemSnapshot, summary: &mut Summary, fem: &dyn FemLink| -> anyhow::Result<()> {
-        let values = probes.sample(fem.mesh(), snap);
+    let mut sample = |t: f64, round: &Round, nodes: &Nodes<'_>, summary: &mut Summary| -> anyhow::Result<()> {
+        let started = Instant::now();
+        let fem = match (&nodes.fem, &round.fem) {
+            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "fem-node")?)),
+            _ => None,
+        };
+        let sph = match (&nodes.sph, &round.sph) {
+            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "sph-node")?)),
+            _ => None,
+        };
+        let values = probes.sample(fem, sph);
         csv.push(t, &values)?;
         for (line, v) in series.iter_mut().zip(&values) {
             line.push((t, *v));
         }
-        frames.write_structure(summary.frames as usize, t, fem.mesh(), snap)?;
+        let index = summary.frames as usize;
+        if let Some((mesh, snap)) = fem {
+            frames.write_structure(index, t, mesh, snap)?;
+        }
+        if let Some((setup, snap)) = sph {
+            write_particles(&mut frames, index, t, setup, snap)?;
+        }
         summary.frames += 1;
         summary.samples += 1;
+        summary.timings.broker += started.elapsed().as_secs_f64();
         Ok(())
     };
 
     let mut t = 0.0;
     let mut step = 0u64;
-    let state = exchange(fem, summary, step, t, command(0.0, true, false))?;
-    let t0 = Instant::now();
-    sample(t, snapshot(&state)?, summary, fem)?;
-    summary.timings.broker += t0.elapsed().as_secs_f64();
+    let round = exchange(nodes, summary, step, t, command(0.0, true, false))?;
+    sample(t, &round, nodes, summary)?;
+    let mut dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
     let mut next_output = 1u64;
     while t < end {
         let target = (next_output as f64 * interval).min(end);
-        let mut dt = s.coupling.max_dt.min(target - t);
-        let lands = target - (t + dt) <= LANDING * s.coupling.max_dt;
+        // §3 step 1: the coupling step is the fluid's stable step, capped by the user and the next output time.
+        let cap = s.coupling.max_dt.min(dt_fluid);
+        let mut dt = cap.min(target - t);
+        let lands = target - (t + dt) <= LANDING * cap;
         if lands {
             dt = target - t;
         }
         step += 1;
-        let state = exchange(fem, summary, step, t, command(dt, lands, false))?;
-        summary.fem_substeps += u64::from(state.substeps);
+        let round = exchange(nodes, summary, step, t, command(dt, lands, false))?;
+        if let Some(state) = &round.fem {
+            summary.fem_substeps += u64::from(state.substeps);
+        }
+        if let Some(state) = &round.sph {
+            dt_fluid = state.dt_stable;
+        }
         t = if lands { target } else { t + dt };
         summary.steps = step;
         summary.sim_time = t;
         if lands {
-            let t0 = Instant::now();
-            sample(t, snapshot(&state)?, summary, fem)?;
-            summary.timings.broker += t0.elapsed().as_secs_f64();
+            sample(t, &round, nodes, summary)?;
             if target >= next_output as f64 * interval {
                 next_output += 1;
             }
         }
         progress(Progress { step, t, end_time: end });
     }
-    exchange(fem, summary, step + 1, t, command(0.0, false, true))?;
+    let stop = command(0.0, false, true);
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        link.send(step + 1, t, stop.clone())?;
+    }
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        link.send(step + 1, t, stop)?;
+    }
     Ok(())
 }
 
@@ -201,44 +249,82 @@ fn command(dt: f64, want_snapshot: bool, stop: bool) -> StepCommand {
     }
 }
 
-fn snapshot(state: &FemState) -> anyhow::Result<&FemSnapshot> {
-    state
-        .snapshot
-        .as_ref()
-        .ok_or_else(|| anyhow::anyhow!("fem-node: answered an output step without a snapshot"))
+fn snapshot<'s, T>(snap: Option<&'s T>, node: &str) -> anyhow::Result<&'s T> {
+    snap.ok_or_else(|| anyhow::anyhow!("{node}: answered an output step without a snapshot"))
 }
 
-/// One round trip, timed: the node's own compute time counts as `fem`, the rest as `messaging`.
+/// Fluid and wall particles in one frame, told apart by `wall` (0 fluid, 1 wall).
+fn write_particles(
+    frames: &mut FrameWriter,
+    index: usize,
+    t: f64,
+    setup: &SphSetup,
+    snap: &SphSnapshot,
+) -> anyhow::Result<()> {
+    let x: Vec<[f64; 2]> = snap.x.iter().chain(&setup.walls).copied().collect();
+    let walls = setup.walls.len();
+    let v: Vec<[f64; 2]> = snap
+        .v
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n([0.0; 2], walls))
+        .collect();
+    let p: Vec<f64> = snap.p.iter().chain(&snap.wall_p).copied().collect();
+    let rho: Vec<f64> = snap
+        .rho
+        .iter()
+        .copied()
+        .chain(std::iter::repeat_n(setup.density, walls))
+        .collect();
+    let kind: Vec<f64> = std::iter::repeat_n(0.0, snap.x.len())
+        .chain(std::iter::repeat_n(1.0, walls))
+        .collect();
+    frames.write_particles(
+        index,
+        t,
+        &x,
+        &[
+            PointField::Vector("velocity", &v),
+            PointField::Scalar("pressure", &p),
+            PointField::Scalar("density", &rho),
+            PointField::Scalar("wall", &kind),
+        ],
+    )?;
+    Ok(())
+}
+
+/// One coupling step with every node: send to all, then collect all, so processes compute side by side. The
+/// nodes' own compute time counts as `fem`/`sph`; the rest of the round, beyond the slower node, as `messaging`.
 fn exchange(
-    fem: &mut dyn FemLink,
+    nodes: &mut Nodes<'_>,
     summary: &mut Summary,
     step: u64,
     t: f64,
     cmd: StepCommand,
-) -> anyhow::Result<FemState> {
-    let stop = cmd.stop;
-    let t0 = Instant::now();
-    let reply = fem
-        .exchange(step, t, cmd)
-        .with_context(|| format!("coupling step {step} from t = {t} s"))?;
-    let wall = t0.elapsed().as_secs_f64();
-    match reply {
-        Some(state) => {
-            summary.timings.fem += state.compute_seconds;
-            summary.timings.messaging += (wall - state.compute_seconds).max(0.0);
-            Ok(state)
-        }
-        None if stop => Ok(FemState {
-            ids: Vec::new(),
-            x: Vec::new(),
-            v: Vec::new(),
-            substeps: 0,
-            dt_stable: 0.0,
-            compute_seconds: 0.0,
-            snapshot: None,
-        }),
-        None => anyhow::bail!("fem-node: no answer to step {step}"),
+) -> anyhow::Result<Round> {
+    let context = || format!("coupling step {step} from t = {t} s");
+    let started = Instant::now();
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        link.send(step, t, cmd.clone()).with_context(context)?;
     }
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        link.send(step, t, cmd).with_context(context)?;
+    }
+    let sph = match nodes.sph.as_deref_mut() {
+        Some(link) => Some(link.receive(step).with_context(context)?),
+        None => None,
+    };
+    let fem = match nodes.fem.as_deref_mut() {
+        Some(link) => Some(link.receive(step).with_context(context)?),
+        None => None,
+    };
+    let wall = started.elapsed().as_secs_f64();
+    let c_fem = fem.as_ref().map_or(0.0, |s| s.compute_seconds());
+    let c_sph = sph.as_ref().map_or(0.0, |s| s.compute_seconds());
+    summary.timings.fem += c_fem;
+    summary.timings.sph += c_sph;
+    summary.timings.messaging += (wall - c_fem.max(c_sph)).max(0.0);
+    Ok(Round { fem, sph })
 }
 
 fn plot_all(scene: &LoadedScene, out: &Path, series: &Series) -> anyhow::Result<()> {

@@ -1,9 +1,10 @@
-//! The coordinator's view of a solver node: send a step command, get the node's state back.
+//! The coordinator's view of a solver node: send a step command, later receive the node's state.
 //!
 //! The same coordinator drives a node in this process (a direct call) or in another process (zenoh), so the
-//! physics and the outputs cannot differ between the two modes.
+//! physics and the outputs cannot differ between the two modes. Sending and receiving are separate so that the
+//! structure and fluid nodes compute a step at the same time when they run as processes.
 
-use cosim_proto::messages::{FemMesh, FemState, StepCommand};
+use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState, StepCommand};
 
 /// Why a node could not answer.
 #[derive(Debug, thiserror::Error)]
@@ -36,11 +37,89 @@ impl LinkError {
     }
 }
 
-/// A structure node as the coordinator sees it.
-pub trait FemLink {
-    /// The reference mesh the node registered.
-    fn mesh(&self) -> &FemMesh;
+/// What the coordinator reads from every node's answer.
+pub trait Reply {
+    /// Seconds the node computed for this step.
+    fn compute_seconds(&self) -> f64;
+}
 
-    /// Send `cmd` for coupling step `step` starting at time `t`; the node's answer, or `None` for a stop command.
-    fn exchange(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<Option<FemState>, LinkError>;
+impl Reply for FemState {
+    fn compute_seconds(&self) -> f64 {
+        self.compute_seconds
+    }
+}
+
+impl Reply for SphState {
+    fn compute_seconds(&self) -> f64 {
+        self.compute_seconds
+    }
+}
+
+/// A solver node as the coordinator sees it.
+pub trait NodeLink {
+    /// What the node registered with (mesh, particle setup).
+    type Setup;
+    /// Its answer to a step.
+    type State: Reply;
+
+    /// The registration message.
+    fn setup(&self) -> &Self::Setup;
+
+    /// Send `cmd` for coupling step `step` starting at time `t`. After a stop command nothing is received.
+    fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError>;
+
+    /// The node's answer to the command of step `step`.
+    fn receive(&mut self, step: u64) -> Result<Self::State, LinkError>;
+}
+
+/// The structure node.
+pub type FemLink = dyn NodeLink<Setup = FemMesh, State = FemState>;
+/// The fluid node.
+pub type SphLink = dyn NodeLink<Setup = SphSetup, State = SphState>;
+
+/// A node in this process: a handler called when its answer is asked for.
+pub struct InProcess<S, T> {
+    setup: S,
+    handler: Box<dyn FnMut(&StepCommand) -> Result<Option<T>, LinkError>>,
+    pending: Option<StepCommand>,
+}
+
+impl<S, T> InProcess<S, T> {
+    /// A node from its registration message and its step handler.
+    pub fn new(setup: S, handler: impl FnMut(&StepCommand) -> Result<Option<T>, LinkError> + 'static) -> Self {
+        Self {
+            setup,
+            handler: Box::new(handler),
+            pending: None,
+        }
+    }
+}
+
+impl<S, T: Reply> NodeLink for InProcess<S, T> {
+    type Setup = S;
+    type State = T;
+
+    fn setup(&self) -> &S {
+        &self.setup
+    }
+
+    fn send(&mut self, _step: u64, _t: f64, cmd: StepCommand) -> Result<(), LinkError> {
+        if cmd.stop {
+            (self.handler)(&cmd)?;
+        } else {
+            self.pending = Some(cmd);
+        }
+        Ok(())
+    }
+
+    fn receive(&mut self, step: u64) -> Result<T, LinkError> {
+        let cmd = self.pending.take().ok_or_else(|| LinkError::Failed {
+            node: "in-process node".into(),
+            message: format!("asked for step {step} without a command"),
+        })?;
+        (self.handler)(&cmd)?.ok_or_else(|| LinkError::Failed {
+            node: "in-process node".into(),
+            message: format!("no answer to step {step}"),
+        })
+    }
 }

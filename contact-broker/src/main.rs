@@ -9,9 +9,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use contact_broker::coordinator::{self, Progress, RunInfo};
-use contact_broker::transport::{self, ZenohFemLink};
+use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
+use contact_broker::link::{FemLink, SphLink};
+use contact_broker::transport::{self, ZenohLink};
 use cosim_proto::keys::{key, topic, valid_run_id};
+use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 
 /// The co-simulation's step coordinator and contact broker.
 #[derive(Parser, Debug)]
@@ -76,7 +78,14 @@ fn run(args: Args) -> anyhow::Result<()> {
         )
     })?;
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
-    let subs = transport::subscribe_fem(&session, &args.run)?;
+    let fem_subs = match scene.scene.solids.is_empty() {
+        false => Some(transport::subscribe(&session, &args.run, cosim_proto::keys::FEM)?),
+        true => None,
+    };
+    let sph_subs = match scene.scene.fluid {
+        Some(_) => Some(transport::subscribe(&session, &args.run, cosim_proto::keys::SPH)?),
+        None => None,
+    };
     let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
     let _alive = session
         .liveliness()
@@ -86,7 +95,18 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     let wait = Duration::from_secs_f64(args.wait_nodes);
     let step_timeout = Duration::from_secs_f64(scene.scene.coupling.step_timeout);
-    let mut fem = ZenohFemLink::register(&session, &args.run, subs, wait, step_timeout)?;
+    let mut fem: Option<ZenohLink<FemMesh, FemState>> = match fem_subs {
+        Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
+        None => None,
+    };
+    let mut sph: Option<ZenohLink<SphSetup, SphState>> = match sph_subs {
+        Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
+        None => None,
+    };
+    let nodes = Nodes {
+        fem: fem.as_mut().map(|l| l as &mut FemLink),
+        sph: sph.as_mut().map(|l| l as &mut SphLink),
+    };
     let info = RunInfo {
         run_id: args.run.clone(),
         mode: args.mode.clone(),
@@ -99,7 +119,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             emit(serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time}));
         }
     };
-    let outcome = coordinator::run(&scene, &mut fem, &info, &mut report);
+    let outcome = coordinator::run(&scene, nodes, &info, &mut report);
     emit(serde_json::json!({"event": "done", "status": outcome.summary.status, "message": outcome.summary.message}));
     match outcome.error {
         Some(e) => Err(e),

@@ -1,59 +1,95 @@
-//! Probes of `DESIGN.md` §5 evaluated on structure snapshots.
+//! Probes of `DESIGN.md` §5, evaluated on the nodes' snapshots at output times.
 
-use cosim_proto::messages::{FemMesh, FemSnapshot};
-use cosim_proto::scene::{EnergyPart, ProbeKind, ProbeSpec, Scene};
+use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
+use cosim_proto::scene::{EnergyOf, EnergyPart, ProbeKind, Scene};
+use sph_node::kernel::CubicSpline;
 
-/// A probe resolved against the mesh.
+/// A probe resolved against the registered mesh and particles.
 #[derive(Clone, Debug)]
 enum Resolved {
-    /// Displacement component of one node.
+    /// Displacement component of one FE node.
     Node { node: usize, component: usize },
-    /// Energy of one solid or all of them.
-    Energy { part: EnergyPart, solid: Option<usize> },
+    /// Energy of one solid, all solids, the fluid, or everything.
+    Energy {
+        part: EnergyPart,
+        solid: Option<usize>,
+        of: EnergyOf,
+    },
+    /// Largest fluid coordinate along a component.
+    Front { component: usize },
+    /// Highest fluid particle with x ≤ x_max.
+    Column { x_max: f64 },
+    /// Shepard-normalised SPH pressure at a point.
+    Pressure { point: [f64; 2] },
 }
 
-/// All probes of a scene, resolved once against the registered mesh.
+/// All probes of a scene, resolved once.
 #[derive(Clone, Debug)]
 pub struct Probes {
     names: Vec<String>,
     resolved: Vec<Resolved>,
+    gravity: [f64; 2],
+    /// Fluid positions of the first sample (potential energy is measured from there, as for the structure).
+    fluid_x0: Option<Vec<[f64; 2]>>,
 }
 
 impl Probes {
     /// Resolve every probe (nearest node in the reference configuration, solid indices).
-    pub fn resolve(scene: &Scene, mesh: &FemMesh) -> Result<Self, String> {
-        let solid_index = |name: &str| mesh.solid_names.iter().position(|s| s == name);
+    pub fn resolve(scene: &Scene, mesh: Option<&FemMesh>, fluid: Option<&SphSetup>) -> Result<Self, String> {
         let mut resolved = Vec::with_capacity(scene.probes.len());
+        let solid_index = |p: usize, name: &str| -> Result<usize, String> {
+            let mesh = mesh.ok_or_else(|| format!("probe[{p}].solid: the run has no structure node"))?;
+            mesh.solid_names
+                .iter()
+                .position(|s| s == name)
+                .ok_or_else(|| format!("probe[{p}].solid: the structure node has no solid `{name}`"))
+        };
+        let need_fluid = |p: usize| {
+            fluid
+                .map(|_| ())
+                .ok_or_else(|| format!("probe[{p}].kind: the run has no fluid node"))
+        };
         for (p, spec) in scene.probes.iter().enumerate() {
+            let missing = |k: &str| format!("probe[{p}].{k}: missing");
             resolved.push(match spec.kind {
                 ProbeKind::NodeDisplacement => {
-                    let (solid, point, component) = node_probe_keys(spec)
-                        .ok_or_else(|| format!("probe[{p}]: node_displacement needs solid, point and component"))?;
-                    let s = solid_index(solid)
-                        .ok_or_else(|| format!("probe[{p}].solid: the FEM node has no solid `{solid}`"))?;
-                    let node = nearest_node(mesh, s, point)
-                        .ok_or_else(|| format!("probe[{p}].solid: solid `{solid}` has no node"))?;
-                    Resolved::Node {
-                        node,
-                        component: component.index(),
+                    let solid = solid_index(p, spec.solid.as_deref().ok_or_else(|| missing("solid"))?)?;
+                    let point = spec.point.ok_or_else(|| missing("point"))?;
+                    let component = spec.component.ok_or_else(|| missing("component"))?.index();
+                    let node = nearest_node(mesh.expect("checked by solid_index"), solid, point)
+                        .ok_or_else(|| format!("probe[{p}].solid: the solid has no node"))?;
+                    Resolved::Node { node, component }
+                }
+                ProbeKind::Energy => Resolved::Energy {
+                    part: spec.part.ok_or_else(|| missing("part"))?,
+                    solid: spec.solid.as_deref().map(|n| solid_index(p, n)).transpose()?,
+                    of: spec.of.unwrap_or(EnergyOf::All),
+                },
+                ProbeKind::SurgeFront => {
+                    need_fluid(p)?;
+                    Resolved::Front {
+                        component: spec.component.ok_or_else(|| missing("component"))?.index(),
                     }
                 }
-                ProbeKind::Energy => {
-                    let solid = match &spec.solid {
-                        Some(name) => Some(
-                            solid_index(name)
-                                .ok_or_else(|| format!("probe[{p}].solid: the FEM node has no solid `{name}`"))?,
-                        ),
-                        None => None,
-                    };
-                    let part = spec.part.ok_or_else(|| format!("probe[{p}].part: missing"))?;
-                    Resolved::Energy { part, solid }
+                ProbeKind::ColumnHeight => {
+                    need_fluid(p)?;
+                    Resolved::Column {
+                        x_max: spec.x_max.ok_or_else(|| missing("x_max"))?,
+                    }
+                }
+                ProbeKind::Pressure => {
+                    need_fluid(p)?;
+                    Resolved::Pressure {
+                        point: spec.point.ok_or_else(|| missing("point"))?,
+                    }
                 }
             });
         }
         Ok(Self {
             names: scene.probes.iter().map(|p| p.name.clone()).collect(),
             resolved,
+            gravity: scene.run.gravity,
+            fluid_x0: None,
         })
     }
 
@@ -62,31 +98,113 @@ impl Probes {
         &self.names
     }
 
-    /// Evaluate every probe on a snapshot.
-    pub fn sample(&self, mesh: &FemMesh, snap: &FemSnapshot) -> Vec<f64> {
+    /// Evaluate every probe on the snapshots of this output time.
+    pub fn sample(
+        &mut self,
+        fem: Option<(&FemMesh, &FemSnapshot)>,
+        sph: Option<(&SphSetup, &SphSnapshot)>,
+    ) -> Vec<f64> {
+        if let (None, Some((_, snap))) = (&self.fluid_x0, sph) {
+            self.fluid_x0 = Some(snap.x.clone());
+        }
         self.resolved
             .iter()
             .map(|r| match *r {
-                Resolved::Node { node, component } => snap.x[node][component] - mesh.nodes[node][component],
-                Resolved::Energy { part, solid } => snap
-                    .energies
-                    .iter()
-                    .enumerate()
-                    .filter(|(s, _)| solid.is_none_or(|want| want == *s))
-                    .map(|(_, e)| match part {
-                        EnergyPart::Kinetic => e.kinetic,
-                        EnergyPart::Strain => e.strain,
-                        EnergyPart::Potential => e.potential,
-                        EnergyPart::Total => e.kinetic + e.strain + e.potential,
-                    })
-                    .sum(),
+                Resolved::Node { node, component } => fem.map_or(f64::NAN, |(mesh, snap)| {
+                    snap.x[node][component] - mesh.nodes[node][component]
+                }),
+                Resolved::Energy { part, solid, of } => {
+                    let structure = match (of, fem) {
+                        (EnergyOf::Structure | EnergyOf::All, Some((_, snap))) => structure_energy(snap, part, solid),
+                        _ => 0.0,
+                    };
+                    let fluid = match (of, sph, solid) {
+                        (EnergyOf::Fluid | EnergyOf::All, Some((_, snap)), None) => self.fluid_energy(snap, part),
+                        _ => 0.0,
+                    };
+                    structure + fluid
+                }
+                Resolved::Front { component } => sph.map_or(f64::NAN, |(_, s)| {
+                    s.x.iter().map(|x| x[component]).fold(f64::NEG_INFINITY, f64::max)
+                }),
+                Resolved::Column { x_max } => sph.map_or(f64::NAN, |(_, s)| {
+                    s.x.iter()
+                        .filter(|x| x[0] <= x_max)
+                        .map(|x| x[1])
+                        .fold(f64::NEG_INFINITY, f64::max)
+                }),
+                Resolved::Pressure { point } => sph.map_or(f64::NAN, |(setup, s)| pressure_at(setup, s, point)),
             })
             .collect()
     }
+
+    fn fluid_energy(&self, snap: &SphSnapshot, part: EnergyPart) -> f64 {
+        let kinetic = || {
+            snap.m
+                .iter()
+                .zip(&snap.v)
+                .map(|(m, v)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
+                .sum::<f64>()
+        };
+        let potential = || match &self.fluid_x0 {
+            Some(x0) => snap
+                .m
+                .iter()
+                .zip(snap.x.iter().zip(x0))
+                .map(|(m, (x, x0))| -m * (self.gravity[0] * (x[0] - x0[0]) + self.gravity[1] * (x[1] - x0[1])))
+                .sum::<f64>(),
+            None => 0.0,
+        };
+        match part {
+            EnergyPart::Kinetic => kinetic(),
+            EnergyPart::Potential => potential(),
+            EnergyPart::Strain => 0.0,
+            EnergyPart::Total => kinetic() + potential(),
+        }
+    }
 }
 
-fn node_probe_keys(spec: &ProbeSpec) -> Option<(&str, [f64; 2], cosim_proto::scene::Component)> {
-    Some((spec.solid.as_deref()?, spec.point?, spec.component?))
+fn structure_energy(snap: &FemSnapshot, part: EnergyPart, solid: Option<usize>) -> f64 {
+    snap.energies
+        .iter()
+        .enumerate()
+        .filter(|(s, _)| solid.is_none_or(|want| want == *s))
+        .map(|(_, e)| match part {
+            EnergyPart::Kinetic => e.kinetic,
+            EnergyPart::Strain => e.strain,
+            EnergyPart::Potential => e.potential,
+            EnergyPart::Total => e.kinetic + e.strain + e.potential,
+        })
+        .sum()
+}
+
+/// Shepard-normalised SPH interpolation Σ p_j V_j W / Σ V_j W over fluid and wall particles (walls carry their
+/// extrapolated pressure and the lattice volume Δx²); NaN where no particle is within the kernel support.
+fn pressure_at(setup: &SphSetup, snap: &SphSnapshot, point: [f64; 2]) -> f64 {
+    let kernel = CubicSpline::new(setup.h);
+    let support2 = kernel.support() * kernel.support();
+    let wall_volume = setup.spacing * setup.spacing;
+    let fluid = snap
+        .x
+        .iter()
+        .zip(snap.m.iter().zip(&snap.rho))
+        .zip(&snap.p)
+        .map(|((x, (m, rho)), p)| (x, m / rho, p));
+    let walls = setup.walls.iter().zip(&snap.wall_p).map(|(x, p)| (x, wall_volume, p));
+    let (mut num, mut den) = (0.0, 0.0);
+    for (x, volume, p) in fluid.chain(walls) {
+        let r2 = (x[0] - point[0]).powi(2) + (x[1] - point[1]).powi(2);
+        if r2 < support2 {
+            let w = kernel.w(r2.sqrt()) * volume;
+            num += p * w;
+            den += w;
+        }
+    }
+    if den > 0.0 {
+        num / den
+    } else {
+        f64::NAN
+    }
 }
 
 /// The node of solid `solid` nearest `point` in the reference configuration; ties go to the lowest id.

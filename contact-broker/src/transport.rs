@@ -5,8 +5,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use cosim_proto::envelope::{CodecError, Envelope};
-use cosim_proto::keys::{key, topic};
-use cosim_proto::messages::{FemMesh, FemState, NodeError, StepCommand};
+use cosim_proto::keys::{key, topic, NodeTopics};
+use cosim_proto::messages::{NodeError, StepCommand};
+use serde::de::DeserializeOwned;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
@@ -14,51 +15,9 @@ use zenoh::query::Queryable;
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
-use crate::link::{FemLink, LinkError};
+use crate::link::{LinkError, NodeLink, Reply};
 
-/// Open a peer session with the project's settings (loopback by default, multicast scouting off).
-pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
-    let mut config = zenoh::Config::default();
-    for (k, v) in cosim_proto::session::peer_settings(listen, connect, timeout_ms) {
-        config
-            .insert_json5(&k, &v)
-            .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
-    }
-    zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
-}
-
-/// Open the broker's session. A TCP listen endpoint with port 0 gets a free port picked here (zenoh's own
-/// listing of bound locators is an unstable API), retried a few times in case another program takes it first.
-/// Returns the session and the endpoints it listens on.
-pub fn open_listening(
-    listen: &[String],
-    connect: &[String],
-    timeout_ms: u64,
-) -> anyhow::Result<(Session, Vec<String>)> {
-    let mut last = None;
-    for _ in 0..5 {
-        let endpoints = listen.iter().map(|e| concrete(e)).collect::<anyhow::Result<Vec<_>>>()?;
-        match open_session(&endpoints, connect, timeout_ms) {
-            Ok(session) => return Ok((session, endpoints)),
-            Err(e) => last = Some(e),
-        }
-    }
-    Err(last.expect("at least one attempt"))
-}
-
-/// `tcp/HOST:0` with a free port of HOST; other endpoints unchanged.
-fn concrete(endpoint: &str) -> anyhow::Result<String> {
-    match endpoint.strip_prefix("tcp/").and_then(|a| a.strip_suffix(":0")) {
-        Some(host) => {
-            let port = std::net::TcpListener::bind((host, 0))
-                .and_then(|l| l.local_addr())
-                .with_context(|| format!("no free port on {host}"))?
-                .port();
-            Ok(format!("tcp/{host}:{port}"))
-        }
-        None => Ok(endpoint.to_string()),
-    }
-}
+pub use cosim_bus::session::{open_listening, open_session};
 
 /// Answer `cosim/<run>/scene` with the resolved scene (TOML text) for as long as the returned handle lives.
 pub fn serve_scene(session: &Session, run: &str, scene_toml: String) -> anyhow::Result<Queryable<()>> {
@@ -75,157 +34,173 @@ pub fn serve_scene(session: &Session, run: &str, scene_toml: String) -> anyhow::
 
 type Sub = Subscriber<FifoChannelHandler<Sample>>;
 
-/// A structure node in another process.
-pub struct ZenohFemLink {
-    run: String,
-    mesh: FemMesh,
-    command: Publisher<'static>,
-    state: Sub,
-    error: Sub,
-    alive: Sub,
-    step_timeout: Duration,
-}
-
-/// Subscribers the broker declares before any node can register, so that no message is missed.
-pub struct FemSubscriptions {
-    mesh: Sub,
+/// Subscriptions the broker declares before any node can register, so that no message is missed.
+pub struct Subscriptions {
+    topics: NodeTopics,
+    setup: Sub,
     state: Sub,
     error: Sub,
     alive: Sub,
 }
 
-/// Declare the broker's subscriptions for the FEM node.
-pub fn subscribe_fem(session: &Session, run: &str) -> anyhow::Result<FemSubscriptions> {
+/// Declare the broker's subscriptions for one node.
+pub fn subscribe(session: &Session, run: &str, topics: NodeTopics) -> anyhow::Result<Subscriptions> {
     let sub = |t: &str| {
         session
             .declare_subscriber(key(run, t))
             .wait()
             .map_err(|e| anyhow::anyhow!("{e}"))
     };
-    Ok(FemSubscriptions {
-        mesh: sub(topic::FEM_MESH)?,
-        state: sub(topic::FEM_STATE)?,
-        error: sub(topic::FEM_ERROR)?,
+    Ok(Subscriptions {
+        topics,
+        setup: sub(topics.setup)?,
+        state: sub(topics.state)?,
+        error: sub(topics.error)?,
         alive: session
             .liveliness()
-            .declare_subscriber(key(run, topic::FEM_ALIVE))
+            .declare_subscriber(key(run, topics.alive))
             .history(true)
             .wait()
             .map_err(|e| anyhow::anyhow!("{e}"))?,
     })
 }
 
-fn failed(message: impl Into<String>) -> LinkError {
-    LinkError::Failed {
-        node: "fem-node".into(),
-        message: message.into(),
-    }
+/// A node in another process.
+pub struct ZenohLink<S, T> {
+    run: String,
+    topics: NodeTopics,
+    setup: S,
+    command: Publisher<'static>,
+    state: Sub,
+    error: Sub,
+    alive: Sub,
+    step_timeout: Duration,
+    _state: std::marker::PhantomData<T>,
 }
 
-/// Turn a `fem/error` sample into the error the run ends with.
-fn node_error(sample: &Sample, run: &str) -> LinkError {
-    match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, "fem/error") {
+/// Turn an error sample into the error the run ends with.
+fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> LinkError {
+    let node = topics.name.to_string();
+    match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, topics.error) {
         Ok(env) if env.body.status == "unstable" => LinkError::Unstable {
-            node: "fem-node".into(),
+            node,
             message: env.body.message,
         },
-        Ok(env) => failed(env.body.message),
-        Err(e) => failed(format!("sent an undecodable error report: {e}")),
+        Ok(env) => LinkError::Failed {
+            node,
+            message: env.body.message,
+        },
+        Err(e) => LinkError::Failed {
+            node,
+            message: format!("sent an undecodable error report: {e}"),
+        },
     }
 }
 
-impl ZenohFemLink {
-    /// Wait (at most `wait`) for a FEM node to register its mesh, then build the link.
+impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
+    /// Wait (at most `wait`) for the node to register, then build the link.
     pub fn register(
         session: &Session,
         run: &str,
-        subs: FemSubscriptions,
+        subs: Subscriptions,
         wait: Duration,
         step_timeout: Duration,
     ) -> anyhow::Result<Self> {
+        let topics = subs.topics;
         let deadline = Instant::now() + wait;
-        let mesh = loop {
-            if let Some(sample) = subs
-                .mesh
+        let setup = loop {
+            let got = subs
+                .setup
                 .recv_timeout(Duration::from_millis(50))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-            {
-                let env = Envelope::<FemMesh>::decode(&sample.payload().to_bytes(), run, "fem/mesh")
-                    .context("fem-node registration refused")?;
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            if let Some(sample) = got {
+                let env = Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup)
+                    .with_context(|| format!("{} registration refused", topics.name))?;
                 break env.body;
             }
             if let Some(sample) = subs.error.try_recv().map_err(|e| anyhow::anyhow!("{e}"))? {
-                return Err(node_error(&sample, run).into());
+                return Err(node_error(&sample, run, &topics).into());
             }
             if Instant::now() > deadline {
-                anyhow::bail!("fem-node: did not register within {:.0} s", wait.as_secs_f64());
+                anyhow::bail!("{}: did not register within {:.0} s", topics.name, wait.as_secs_f64());
             }
         };
         let command = session
-            .declare_publisher(key(run, topic::BROKER_FEM))
+            .declare_publisher(key(run, topics.command))
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()
             .map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(Self {
             run: run.to_string(),
-            mesh,
+            topics,
+            setup,
             command,
             state: subs.state,
             error: subs.error,
             alive: subs.alive,
             step_timeout,
+            _state: std::marker::PhantomData,
         })
+    }
+
+    fn failed(&self, message: impl Into<String>) -> LinkError {
+        LinkError::Failed {
+            node: self.topics.name.into(),
+            message: message.into(),
+        }
     }
 
     /// A failure the node reported or its death, if either happened.
     fn check_node(&self) -> Result<(), LinkError> {
         if let Ok(Some(sample)) = self.error.try_recv() {
-            return Err(node_error(&sample, &self.run));
+            return Err(node_error(&sample, &self.run, &self.topics));
         }
         while let Ok(Some(sample)) = self.alive.try_recv() {
             if sample.kind() == SampleKind::Delete {
                 // It may have reported why just before it went.
                 if let Ok(Some(sample)) = self.error.recv_timeout(Duration::from_millis(200)) {
-                    return Err(node_error(&sample, &self.run));
+                    return Err(node_error(&sample, &self.run, &self.topics));
                 }
-                return Err(failed("the node died (its liveliness token disappeared)"));
+                return Err(self.failed("the node died (its liveliness token disappeared)"));
             }
         }
         Ok(())
     }
 }
 
-impl FemLink for ZenohFemLink {
-    fn mesh(&self) -> &FemMesh {
-        &self.mesh
+impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S, T> {
+    type Setup = S;
+    type State = T;
+
+    fn setup(&self) -> &S {
+        &self.setup
     }
 
-    fn exchange(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<Option<FemState>, LinkError> {
-        let stop = cmd.stop;
+    fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
         let bytes = Envelope::new(&self.run, step, t, cmd).encode();
         self.command
             .put(bytes)
             .wait()
-            .map_err(|e| failed(format!("cannot send step {step}: {e}")))?;
-        if stop {
-            return Ok(None);
-        }
+            .map_err(|e| self.failed(format!("cannot send step {step}: {e}")))
+    }
+
+    fn receive(&mut self, step: u64) -> Result<T, LinkError> {
         let deadline = Instant::now() + self.step_timeout;
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
-                    let env = Envelope::<FemState>::decode(&sample.payload().to_bytes(), &self.run, "fem/state")
-                        .and_then(|e| e.expect_step(step, "fem/state"))
-                        .map_err(|e: CodecError| failed(format!("refused its state: {e}")))?;
-                    return Ok(Some(env.body));
+                    let env = Envelope::<T>::decode(&sample.payload().to_bytes(), &self.run, self.topics.state)
+                        .and_then(|e| e.expect_step(step, self.topics.state))
+                        .map_err(|e: CodecError| self.failed(format!("refused its state: {e}")))?;
+                    return Ok(env.body);
                 }
                 Ok(None) => {}
-                Err(e) => return Err(failed(format!("state channel closed: {e}"))),
+                Err(e) => return Err(self.failed(format!("state channel closed: {e}"))),
             }
             self.check_node()?;
             if Instant::now() > deadline {
-                return Err(failed(format!(
+                return Err(self.failed(format!(
                     "no answer to step {step} within {:.0} s (coupling.step_timeout)",
                     self.step_timeout.as_secs_f64()
                 )));

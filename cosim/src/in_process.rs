@@ -1,28 +1,16 @@
-//! Every node in this process: the coordinator calls the FEM node's handler directly.
+//! Every node in this process: the coordinator calls the nodes' handlers directly.
 
-use contact_broker::link::{FemLink, LinkError};
-use cosim_proto::messages::{FemMesh, FemState, StepCommand};
+use contact_broker::link::{InProcess, LinkError};
+use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 use fem_node::core::FemCore;
+use sph_node::core::SphCore;
 
-/// The FEM node, in this process.
-pub struct InProcessFem {
-    core: FemCore,
-}
-
-impl InProcessFem {
-    /// Wrap a built node.
-    pub fn new(core: FemCore) -> Self {
-        Self { core }
-    }
-}
-
-impl FemLink for InProcessFem {
-    fn mesh(&self) -> &FemMesh {
-        self.core.mesh()
-    }
-
-    fn exchange(&mut self, _step: u64, _t: f64, cmd: StepCommand) -> Result<Option<FemState>, LinkError> {
-        self.core.handle(&cmd).map_err(|e| {
+/// The structure node, in this process.
+pub fn fem(core: FemCore) -> InProcess<FemMesh, FemState> {
+    let setup = core.mesh().clone();
+    let mut core = core;
+    InProcess::new(setup, move |cmd| {
+        core.handle(cmd).map_err(|e| {
             let (node, message) = ("fem-node".to_string(), e.to_string());
             if e.is_unstable() {
                 LinkError::Unstable { node, message }
@@ -30,5 +18,21 @@ impl FemLink for InProcessFem {
                 LinkError::Failed { node, message }
             }
         })
-    }
+    })
+}
+
+/// The fluid node, in this process.
+pub fn sph(core: SphCore) -> InProcess<SphSetup, SphState> {
+    let setup = core.setup().clone();
+    let mut core = core;
+    InProcess::new(setup, move |cmd| {
+        core.handle(cmd).map_err(|e| {
+            let (node, message) = ("sph-node".to_string(), e.to_string());
+            if e.is_unstable() {
+                LinkError::Unstable { node, message }
+            } else {
+                LinkError::Failed { node, message }
+            }
+        })
+    })
 }

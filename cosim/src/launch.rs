@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use contact_broker::coordinator::{write_summary, Progress, RunInfo};
 use contact_broker::summary::Summary;
+use cosim_proto::scene::Scene;
 
 use crate::cli::RunArgs;
 use crate::progress::Bar;
@@ -120,13 +121,23 @@ fn parse_event(line: &str) -> Option<Event> {
 }
 
 /// Run the scene as processes and return the broker's summary.
-pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Result<Summary> {
+pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -> anyhow::Result<Summary> {
     let broker_bin = find_program("contact-broker")?;
-    let fem_bin = find_program("fem-node")?;
+    // The solver nodes this scene needs.
+    let mut wanted: Vec<&'static str> = Vec::new();
+    if !scene.solids.is_empty() {
+        wanted.push("fem-node");
+    }
+    if scene.fluid.is_some() {
+        wanted.push("sph-node");
+    }
+    let programs = wanted
+        .iter()
+        .map(|n| Ok((*n, find_program(n)?)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let logs = info.out.join("logs");
     std::fs::create_dir_all(&logs)?;
     let broker_log = logs.join("contact-broker.log");
-    let fem_log = logs.join("fem-node.log");
     let started = Instant::now();
 
     let mut broker_args = vec![
@@ -183,13 +194,25 @@ pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Resul
             .cloned()
             .ok_or_else(|| anyhow::anyhow!("contact-broker listens on no TCP endpoint ({endpoints:?})"))?,
     };
-    let mut fem_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
+    let mut node_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
     if let Some(n) = args.threads {
-        fem_args.extend(["--threads".into(), n.to_string()]);
+        node_args.extend(["--threads".into(), n.to_string()]);
     }
-    let mut fem = spawn("fem-node", &fem_bin, &fem_args, &fem_log, Stdio::null())?;
+    let mut nodes = programs
+        .iter()
+        .map(|(name, program)| {
+            spawn(
+                name,
+                program,
+                &node_args,
+                &logs.join(format!("{name}.log")),
+                Stdio::null(),
+            )
+        })
+        .collect::<anyhow::Result<Vec<Guard>>>()?;
 
-    let mut fem_failed_at: Option<Instant> = None;
+    // A node that fails makes the broker fail the run within a step (liveliness); if it does not, stop it.
+    let mut node_failed_at: Option<Instant> = None;
     let broker_status = loop {
         if let Ok(Event::Progress(p)) = rx.recv_timeout(Duration::from_millis(50)) {
             bar.update(p);
@@ -197,19 +220,21 @@ pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Resul
         if let Some(status) = broker.exited() {
             break status;
         }
-        match (fem.exited(), fem_failed_at) {
-            (Some(s), None) if !s.success() => fem_failed_at = Some(Instant::now()),
-            (_, Some(at)) if at.elapsed() > GRACE => {
+        let failed = nodes.iter_mut().any(|n| n.exited().is_some_and(|s| !s.success()));
+        match node_failed_at {
+            None if failed => node_failed_at = Some(Instant::now()),
+            Some(at) if at.elapsed() > GRACE => {
                 let _ = broker.child.kill();
-                let status = broker.child.wait()?;
-                break status;
+                break broker.child.wait()?;
             }
             _ => {}
         }
     };
-    // The broker told the node to stop; give it a moment to exit, then make sure.
-    fem.wait_for(Duration::from_secs(5));
-    drop(fem);
+    // The broker told the nodes to stop; give them a moment to exit, then make sure.
+    for node in &mut nodes {
+        node.wait_for(Duration::from_secs(5));
+    }
+    drop(nodes);
 
     let summary_path = info.out.join("summary.json");
     match std::fs::read_to_string(&summary_path)
@@ -222,11 +247,11 @@ pub fn run_processes(args: &RunArgs, info: &RunInfo, bar: &Bar) -> anyhow::Resul
             let message = if broker_status.success() {
                 "contact-broker exited without a summary".to_string()
             } else {
-                format!(
-                    "contact-broker: {}; fem-node: {}",
-                    last_line(&broker_log),
-                    last_line(&fem_log)
-                )
+                let nodes: Vec<String> = wanted
+                    .iter()
+                    .map(|n| format!("{n}: {}", last_line(&logs.join(format!("{n}.log")))))
+                    .collect();
+                format!("contact-broker: {}; {}", last_line(&broker_log), nodes.join("; "))
             };
             let summary = failed_summary(info, message, started.elapsed().as_secs_f64());
             write_summary(&info.out, &summary)?;

@@ -4,13 +4,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use contact_broker::coordinator::{self, RunInfo};
+use contact_broker::coordinator::{self, Nodes, RunInfo};
+use contact_broker::link::{FemLink, SphLink};
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{self, LoadedScene};
 use fem_node::core::FemCore;
+use sph_node::core::SphCore;
 
 use crate::cli::RunArgs;
-use crate::in_process::InProcessFem;
+use crate::in_process;
 use crate::launch;
 use crate::progress::Bar;
 
@@ -40,7 +42,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let result = if args.in_process {
         run_in_process(args, &scene, &info, &bar)
     } else {
-        launch::run_processes(args, &info, &bar)
+        launch::run_processes(args, &scene.scene, &info, &bar)
     };
     bar.finish();
     match result {
@@ -101,9 +103,19 @@ fn run_in_process(
     if let Some(n) = args.threads {
         rayon_threads(n)?;
     }
-    let core = FemCore::new(&scene.scene).context("fem-node")?;
-    let mut fem = InProcessFem::new(core);
-    let outcome = coordinator::run(scene, &mut fem, info, &mut |p| bar.update(p));
+    let mut fem = match scene.scene.solids.is_empty() {
+        false => Some(in_process::fem(FemCore::new(&scene.scene).context("fem-node")?)),
+        true => None,
+    };
+    let mut sph = match scene.scene.fluid {
+        Some(_) => Some(in_process::sph(SphCore::new(&scene.scene).context("sph-node")?)),
+        None => None,
+    };
+    let nodes = Nodes {
+        fem: fem.as_mut().map(|l| l as &mut FemLink),
+        sph: sph.as_mut().map(|l| l as &mut SphLink),
+    };
+    let outcome = coordinator::run(scene, nodes, info, &mut |p| bar.update(p));
     Ok(outcome.summary)
 }
 

@@ -325,12 +325,35 @@ fn node_with_no_broker_on_its_run_fails_within_seconds() {
 }
 
 #[test]
-fn fluid_scene_is_refused_by_this_build_naming_the_key() {
+fn fluid_with_solid_is_refused_by_this_build_naming_the_key() {
     let text = GOOD.replace(
         "[[solid]]",
         "[fluid]\ndensity = 1000.0\nspacing = 0.01\n[[fluid.block]]\nmin = [0.0, 0.02]\nmax = [0.1, 0.1]\n\n[[solid]]",
     );
-    assert_refused("fluid", &text, "fluid", "structure-only");
+    assert_refused(
+        "fluid",
+        &text,
+        "solid",
+        "fluid-structure contact is not part of the run yet",
+    );
+}
+
+#[test]
+fn spacing_and_smoothing_ratio_out_of_range() {
+    let fluid = |extra: &str| {
+        format!(
+            "version = 1\n[run]\nname = \"f\"\nend_time = 0.01\noutput_interval = 0.005\n[fluid]\ndensity = 1000.0\n{extra}\n[[fluid.block]]\nmin = [0.0, 0.0]\nmax = [0.1, 0.1]\n"
+        )
+    };
+    assert_refused("spacing", &fluid("spacing = 0.0"), "fluid.spacing", "positive");
+    assert_refused(
+        "ratio",
+        &fluid("spacing = 0.01\nsmoothing_ratio = 3.0"),
+        "fluid.smoothing_ratio",
+        "[1, 2]",
+    );
+    let overlap = fluid("spacing = 0.01") + "[[wall]]\nmin = [-0.05, -0.05]\nmax = [0.05, 0.05]\n";
+    assert_refused("overlap", &overlap, "fluid.block[0]", "overlaps wall[0]");
 }
 
 #[test]

@@ -266,3 +266,69 @@ fn a_blow_up_ends_the_run_unstable_and_keeps_what_was_computed() {
         .all(|l| l.split(',').all(|v| v.parse::<f64>().unwrap().is_finite())));
     assert!(out.join("frames/structure.pvd").is_file());
 }
+
+#[test]
+fn fluid_only_dam_break_runs_as_processes_and_replays_in_process_bit_for_bit() {
+    let dir = scratch("fluid");
+    let (a, b) = (dir.join("processes"), dir.join("in-process"));
+    let common = [
+        "run",
+        "scenes/dam_break.toml",
+        "--quiet",
+        "--set",
+        "fluid.spacing=0.01",
+        "--set",
+        "run.end_time=0.05",
+        "--set",
+        "run.output_interval=0.01",
+    ];
+    run_ok(
+        &[
+            &common[..],
+            &[
+                "--out",
+                a.to_str().unwrap(),
+                "--run-id",
+                &run_id("fluid-a"),
+                "--threads",
+                "2",
+            ],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            &common[..],
+            &["--out", b.to_str().unwrap(), "--in-process", "--threads", "1"],
+        ]
+        .concat(),
+    );
+    let s = json(&a.join("summary.json"));
+    assert_eq!(s["status"], "ok");
+    assert_eq!(s["solver"], "wcsph");
+    assert_eq!(s["particles"].as_u64().unwrap(), 10 * 20, "0.1 x 0.2 m at 1 cm");
+    assert_eq!(s["fem_nodes"].as_u64().unwrap(), 0);
+    assert!(s["timings"]["sph"].as_f64().unwrap() > 0.0);
+    let (pa, pb) = (
+        std::fs::read(a.join("probes.csv")).unwrap(),
+        std::fs::read(b.join("probes.csv")).unwrap(),
+    );
+    assert_eq!(pa, pb, "in-process differs from processes");
+    let csv = String::from_utf8(pa).unwrap();
+    assert_eq!(
+        csv.lines().next().unwrap(),
+        "t,surge_front,column_height,p_floor,energy"
+    );
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 6);
+    // The front starts at the column's last particle (a - dx/2) and moves downstream.
+    assert_eq!(rows[0][1], 0.095);
+    assert!(rows[5][1] > rows[0][1] + 0.01, "front moved: {:?}", rows[5]);
+    let pvd = std::fs::read_to_string(a.join("frames/particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 6);
+    assert!(a.join("plots/surge_front.svg").is_file());
+}

@@ -14,6 +14,16 @@ pub mod topic {
     pub const BROKER_FEM: &str = "broker/fem";
     /// Liveliness token of the FEM node.
     pub const FEM_ALIVE: &str = "fem/alive";
+    /// sph → broker, once.
+    pub const SPH_SETUP: &str = "sph/setup";
+    /// sph → broker, each step.
+    pub const SPH_STATE: &str = "sph/state";
+    /// sph → broker, when it fails.
+    pub const SPH_ERROR: &str = "sph/error";
+    /// broker → sph, each step.
+    pub const BROKER_SPH: &str = "broker/sph";
+    /// Liveliness token of the SPH node.
+    pub const SPH_ALIVE: &str = "sph/alive";
     /// Liveliness token of the broker.
     pub const BROKER_ALIVE: &str = "broker/alive";
     /// Status queryable of the FEM node.
@@ -40,3 +50,40 @@ pub fn fresh_run_id() -> String {
         .unwrap_or(0);
     format!("r{:x}{:x}", nanos & 0xffff_ffff_ffff, std::process::id())
 }
+
+/// The topics of one node kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NodeTopics {
+    /// Name in messages (`fem-node`, `sph-node`).
+    pub name: &'static str,
+    /// Registration (node → broker, once).
+    pub setup: &'static str,
+    /// State (node → broker, each step).
+    pub state: &'static str,
+    /// Failure report (node → broker).
+    pub error: &'static str,
+    /// Commands (broker → node).
+    pub command: &'static str,
+    /// Liveliness token.
+    pub alive: &'static str,
+}
+
+/// The structure node's topics.
+pub const FEM: NodeTopics = NodeTopics {
+    name: "fem-node",
+    setup: topic::FEM_MESH,
+    state: topic::FEM_STATE,
+    error: topic::FEM_ERROR,
+    command: topic::BROKER_FEM,
+    alive: topic::FEM_ALIVE,
+};
+
+/// The fluid node's topics.
+pub const SPH: NodeTopics = NodeTopics {
+    name: "sph-node",
+    setup: topic::SPH_SETUP,
+    state: topic::SPH_STATE,
+    error: topic::SPH_ERROR,
+    command: topic::BROKER_SPH,
+    alive: topic::SPH_ALIVE,
+};

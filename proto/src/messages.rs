@@ -119,3 +119,56 @@ pub struct NodeError {
     /// One line saying what went wrong.
     pub message: String,
 }
+
+/// Topic `sph/setup` (sph → broker, once): what the fluid node holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphSetup {
+    /// Fluid particles.
+    pub particles: u32,
+    /// Particle spacing Δx [m].
+    pub spacing: f64,
+    /// Smoothing length h [m].
+    pub h: f64,
+    /// Rest density ρ0 [kg/m³].
+    pub density: f64,
+    /// Fixed wall particle positions (for frames).
+    pub walls: Vec<[f64; 2]>,
+    /// Stable step of the initial state [s].
+    pub dt_stable: f64,
+}
+
+/// A full fluid snapshot for frames and probes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphSnapshot {
+    /// Fluid particle positions.
+    pub x: Vec<[f64; 2]>,
+    /// Velocities.
+    pub v: Vec<[f64; 2]>,
+    /// Densities [kg/m³].
+    pub rho: Vec<f64>,
+    /// Pressures [Pa].
+    pub p: Vec<f64>,
+    /// Masses per unit thickness [kg/m].
+    pub m: Vec<f64>,
+    /// Wall particle pressures [Pa], in the order of [`SphSetup::walls`].
+    pub wall_p: Vec<f64>,
+}
+
+/// Topic `sph/state` (sph → broker, each step).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphState {
+    /// Ids of the particles inside the region of interest.
+    pub ids: Vec<u32>,
+    /// Their positions.
+    pub x: Vec<[f64; 2]>,
+    /// Their velocities.
+    pub v: Vec<[f64; 2]>,
+    /// Their masses.
+    pub m: Vec<f64>,
+    /// Stable SPH step for the next step [s].
+    pub dt_stable: f64,
+    /// Seconds of computation this step took on the node.
+    pub compute_seconds: f64,
+    /// Full snapshot when asked for.
+    pub snapshot: Option<SphSnapshot>,
+}

@@ -358,8 +358,27 @@ impl Default for CouplingSpec {
 pub enum ProbeKind {
     /// Displacement of the FE node nearest `point` (reference configuration), `component` x or y.
     NodeDisplacement,
-    /// Energy of the structures: `part` = kinetic | strain | potential | total; optional `solid`.
+    /// Energy: `part` = kinetic | strain | potential | total, of `solid` (one solid), or of `of` = structure |
+    /// fluid | all (default all).
     Energy,
+    /// Extreme fluid particle coordinate along `component` (the front of a dam break).
+    SurgeFront,
+    /// Highest fluid particle among those with x ≤ `x_max` (the residual column of a dam break).
+    ColumnHeight,
+    /// SPH-interpolated pressure at `point`.
+    Pressure,
+}
+
+/// Which bodies an energy probe sums over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergyOf {
+    /// Every solid.
+    Structure,
+    /// The water.
+    Fluid,
+    /// Both.
+    All,
 }
 
 /// A vector component.
@@ -416,6 +435,12 @@ pub struct ProbeSpec {
     /// Energy part (energy).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub part: Option<EnergyPart>,
+    /// Bodies an energy probe covers (energy; default all).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub of: Option<EnergyOf>,
+    /// Column probes look at particles with x ≤ x_max (column_height).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x_max: Option<f64>,
     /// Reference data drawn in the plot: a CSV file (relative to the scene file) and its columns.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<ReferenceSpec>,
@@ -437,7 +462,10 @@ pub struct ReferenceSpec {
     /// Multiply the value column by this (e.g. to change units).
     #[serde(default = "one")]
     pub scale: f64,
-    /// Add this to the time column.
+    /// Multiply the time column by this (e.g. to turn a dimensionless time into seconds).
+    #[serde(default = "one")]
+    pub t_scale: f64,
+    /// Add this to the time column (after scaling).
     #[serde(default)]
     pub t_offset: f64,
 }
@@ -835,6 +863,23 @@ impl Scene {
                 }
                 ProbeKind::Energy => {
                     check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
+                }
+                ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure => {
+                    check(
+                        self.fluid.is_some(),
+                        || key("kind"),
+                        || "needs a [fluid] in the scene".into(),
+                    )?;
+                    let (needed, present) = match probe.kind {
+                        ProbeKind::SurgeFront => ("component", probe.component.is_some()),
+                        ProbeKind::ColumnHeight => ("x_max", probe.x_max.is_some_and(f64::is_finite)),
+                        _ => ("point", probe.point.is_some()),
+                    };
+                    check(
+                        present,
+                        || key(needed),
+                        || format!("missing key ({:?})", probe.kind).to_lowercase(),
+                    )?;
                 }
             }
             if let Some(r) = &probe.reference {

@@ -64,7 +64,7 @@ pub fn plot_probe(
 }
 
 /// Read a reference curve from the CSV file `path`: the columns named `spec.t` and `spec.value` in its header
-/// row, as `(t + spec.t_offset, value * spec.scale)`.
+/// row, as `(t * spec.t_scale + spec.t_offset, value * spec.scale)`.
 ///
 /// Fields are trimmed and may be quoted; empty lines and lines starting with `#` are skipped. A missing
 /// column, a short row or a field that is not a number is an error naming the file (and the line).
@@ -102,7 +102,7 @@ pub fn read_reference(path: &Path, spec: &ReferenceSpec) -> Result<Vec<(f64, f64
                 .map_err(|_| error(format!("line {line}: column `{name}`: `{f}` is not a number")))
         };
         points.push((
-            number(kt, &spec.t)? + spec.t_offset,
+            number(kt, &spec.t)? * spec.t_scale + spec.t_offset,
             number(kv, &spec.value)? * spec.scale,
         ));
     }
@@ -236,6 +236,7 @@ mod tests {
             label: Some("FEAT level 4".into()),
             scale: 1.0,
             t_offset: 0.0,
+            t_scale: 1.0,
         }
     }
 

@@ -1,0 +1,56 @@
+//! The command line every solver node binary shares: `--run ID --connect ENDPOINT [--threads N]`.
+
+use clap::Parser;
+use cosim_proto::keys::NodeTopics;
+use cosim_proto::scene::Scene;
+
+use crate::serve::{serve, Failure, NodeCore, NodeOptions};
+
+/// A solver node of the co-simulation: joins run ID through ENDPOINT and serves it to the end.
+#[derive(Parser, Debug)]
+#[command(version)]
+struct Args {
+    /// Run id to join.
+    #[arg(long)]
+    run: String,
+    /// Endpoint of the broker or a router, e.g. tcp/127.0.0.1:7447.
+    #[arg(long, required = true)]
+    connect: Vec<String>,
+    /// Endpoints to listen on.
+    #[arg(long)]
+    listen: Vec<String>,
+    /// Seconds to wait for the connection and the scene.
+    #[arg(long, default_value_t = 5.0)]
+    timeout: f64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// The whole `main` of a node binary: parse the arguments, serve, and exit non-zero with one line on stderr.
+pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> Result<C, Failure>) -> ! {
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
+        .with_writer(std::io::stderr)
+        .init();
+    let args = Args::parse();
+    let fail = |message: String| -> ! {
+        eprintln!("{}: {}", topics.name, message.replace('\n', " "));
+        std::process::exit(1)
+    };
+    if let Some(n) = args.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
+            fail(format!("--threads {n}: {e}"));
+        }
+    }
+    let opts = NodeOptions {
+        run: args.run,
+        connect: args.connect,
+        listen: args.listen,
+        timeout_ms: (args.timeout * 1000.0) as u64,
+    };
+    match serve(&opts, topics, build) {
+        Ok(()) => std::process::exit(0),
+        Err(e) => fail(format!("{e:#}")),
+    }
+}

@@ -1,0 +1,192 @@
+//! The loop a solver node runs to serve a run (`docs/PROTOCOL.md` §8): join, fetch the scene, register, then
+//! answer step commands until told to stop. Generic over the node, so the structure and fluid nodes (and any
+//! future one) speak the protocol through the same code.
+
+use std::time::Duration;
+
+use anyhow::Context;
+use cosim_proto::envelope::Envelope;
+use cosim_proto::keys::{key, topic, NodeTopics};
+use cosim_proto::messages::{NodeError, StepCommand};
+use cosim_proto::scene::Scene;
+use serde::Serialize;
+use zenoh::qos::CongestionControl;
+use zenoh::sample::SampleKind;
+use zenoh::{Session, Wait};
+
+/// Where to join.
+#[derive(Clone, Debug)]
+pub struct NodeOptions {
+    /// Run id.
+    pub run: String,
+    /// Endpoints to connect to (the broker's, or a router's).
+    pub connect: Vec<String>,
+    /// Endpoints to listen on (usually none).
+    pub listen: Vec<String>,
+    /// Milliseconds to wait for a connection and for the scene.
+    pub timeout_ms: u64,
+}
+
+/// A node's failure: a numerical blow-up (`unstable`) or anything else.
+#[derive(Debug)]
+pub struct Failure {
+    /// True for a numerical blow-up.
+    pub unstable: bool,
+    /// One line.
+    pub message: String,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Failure {}
+
+/// A solver node as the serving loop sees it.
+pub trait NodeCore {
+    /// Registration message.
+    type Setup: Serialize;
+    /// Answer to a step.
+    type State: Serialize;
+
+    /// The registration message.
+    fn setup(&self) -> &Self::Setup;
+
+    /// Apply the command's corrections, advance, answer; `None` for a stop command.
+    fn handle(&mut self, cmd: &StepCommand) -> Result<Option<Self::State>, Failure>;
+}
+
+fn zerr(e: zenoh::Error) -> anyhow::Error {
+    anyhow::anyhow!("{e}")
+}
+
+/// Join the run and serve it to the end. `build` makes the node from the scene the broker serves. Errors are
+/// also published on the node's error topic so the broker can say why.
+pub fn serve<C: NodeCore>(
+    opts: &NodeOptions,
+    topics: NodeTopics,
+    build: impl FnOnce(&Scene) -> Result<C, Failure>,
+) -> anyhow::Result<()> {
+    let session = crate::session::open_session(&opts.listen, &opts.connect, opts.timeout_ms)
+        .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
+    let run = opts.run.as_str();
+    let errors = session
+        .declare_publisher(key(run, topics.error))
+        .congestion_control(CongestionControl::Block)
+        .wait()
+        .map_err(zerr)?;
+    let report = |status: &str, message: String| {
+        let body = NodeError {
+            status: status.into(),
+            message,
+        };
+        let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
+    };
+    let result = serve_session(&session, opts, topics, build, &report);
+    if let Err(e) = &result {
+        let unstable = e.downcast_ref::<Failure>().is_some_and(|f| f.unstable);
+        report(
+            if unstable { "unstable" } else { "failed" },
+            format!("{e:#}").replace('\n', " "),
+        );
+        // Let the report leave before the session closes.
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    result
+}
+
+fn serve_session<C: NodeCore>(
+    session: &Session,
+    opts: &NodeOptions,
+    topics: NodeTopics,
+    build: impl FnOnce(&Scene) -> Result<C, Failure>,
+    report: &dyn Fn(&str, String),
+) -> anyhow::Result<()> {
+    let run = opts.run.as_str();
+    // The command subscription exists before the node registers, so the first command cannot be missed.
+    let commands = session
+        .declare_subscriber(key(run, topics.command))
+        .wait()
+        .map_err(zerr)?;
+    let broker_alive = session
+        .liveliness()
+        .declare_subscriber(key(run, topic::BROKER_ALIVE))
+        .history(true)
+        .wait()
+        .map_err(zerr)?;
+    let state_pub = session
+        .declare_publisher(key(run, topics.state))
+        .congestion_control(CongestionControl::Block)
+        .express(true)
+        .wait()
+        .map_err(zerr)?;
+    let _alive = session
+        .liveliness()
+        .declare_token(key(run, topics.alive))
+        .wait()
+        .map_err(zerr)?;
+
+    let scene_text = fetch_scene(session, run, Duration::from_millis(opts.timeout_ms))?;
+    let scene = cosim_proto::scene::parse("(scene from the broker)", &scene_text, &[])?;
+    let mut core = build(&scene)?;
+    let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
+    session
+        .put(key(run, topics.setup), setup)
+        .congestion_control(CongestionControl::Block)
+        .wait()
+        .map_err(zerr)?;
+
+    let mut expected = 0u64;
+    let mut t = 0.0;
+    loop {
+        let Some(sample) = commands.recv_timeout(Duration::from_millis(200)).map_err(zerr)? else {
+            while let Ok(Some(s)) = broker_alive.try_recv() {
+                if s.kind() == SampleKind::Delete {
+                    anyhow::bail!("the broker of run {run} went away");
+                }
+            }
+            continue;
+        };
+        let env = match Envelope::<StepCommand>::decode(&sample.payload().to_bytes(), run, topics.command)
+            .and_then(|e| e.expect_step(expected, topics.command))
+        {
+            Ok(env) => env,
+            Err(e) => {
+                // Refused, never applied: say so and keep the state as it is.
+                tracing::error!("{e}");
+                report("failed", format!("refused a command: {e}"));
+                continue;
+            }
+        };
+        expected += 1;
+        let dt = env.body.dt;
+        let Some(state) = core.handle(&env.body)? else {
+            return Ok(());
+        };
+        t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
+        state_pub
+            .put(Envelope::new(run, env.step, t, state).encode())
+            .wait()
+            .map_err(zerr)?;
+    }
+}
+
+fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
+    let replies = session
+        .get(key(run, topic::SCENE))
+        .timeout(timeout)
+        .wait()
+        .map_err(zerr)?;
+    match replies.recv() {
+        Ok(reply) => match reply.result() {
+            Ok(sample) => Ok(String::from_utf8(sample.payload().to_bytes().into_owned())?),
+            Err(e) => anyhow::bail!("the broker refused the scene query: {e:?}"),
+        },
+        Err(_) => anyhow::bail!(
+            "no broker of run {run} answered within {:.0} s (is `--run` right?)",
+            timeout.as_secs_f64()
+        ),
+    }
+}

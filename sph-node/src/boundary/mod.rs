@@ -1,0 +1,4 @@
+//! Rigid walls (`DESIGN.md` §4.7): fixed boundary particles and their pressure.
+
+pub mod adami;
+pub mod walls;

@@ -1,0 +1,95 @@
+//! The SPH node's message handler: turns step commands into states. No messaging here — the zenoh adapter
+//! (`node.rs`, through `cosim_bus::serve`) and the in-process launcher both call it, so the two modes compute the
+//! same bits.
+
+use std::time::Instant;
+
+use cosim_proto::messages::{SphSetup, SphSnapshot, SphState, StepCommand};
+use cosim_proto::scene::Scene;
+
+use crate::error::SphError;
+use crate::solver::WcsphSolver;
+
+/// A fluid node: the solver plus what it tells the broker.
+pub struct SphCore {
+    solver: WcsphSolver,
+    setup: SphSetup,
+}
+
+impl SphCore {
+    /// Fill the scene's fluid blocks and walls with particles.
+    pub fn new(scene: &Scene) -> Result<Self, SphError> {
+        let solver = WcsphSolver::new(scene)?;
+        let params = solver.params();
+        let setup = SphSetup {
+            particles: solver.state().len() as u32,
+            spacing: params.dx,
+            h: params.h,
+            density: scene.fluid.as_ref().map_or(1000.0, |f| f.density),
+            walls: solver.walls().x.clone(),
+            dt_stable: solver.stable_dt(),
+        };
+        Ok(Self { solver, setup })
+    }
+
+    /// The `sph/setup` registration message.
+    pub fn setup(&self) -> &SphSetup {
+        &self.setup
+    }
+
+    /// The solver (tests, checkpoints).
+    pub fn solver(&self) -> &WcsphSolver {
+        &self.solver
+    }
+
+    /// Advance by `dt` (in as many equal stable steps as it takes, normally one) and answer. `None` for a stop.
+    pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, SphError> {
+        let started = Instant::now();
+        if !cmd.corrections.is_empty() {
+            // Contact corrections arrive with the broker's contact pass; until the fluid node applies them,
+            // refusing is better than silently dropping them.
+            return Err(SphError::InvalidParameter {
+                name: "corrections",
+                message: "this fluid node does not apply contact corrections yet".into(),
+            });
+        }
+        if cmd.stop {
+            return Ok(None);
+        }
+        if cmd.dt > 0.0 {
+            let k = (cmd.dt / self.solver.stable_dt()).ceil().max(1.0);
+            for _ in 0..k as u64 {
+                self.solver.step(cmd.dt / k)?;
+            }
+        }
+        let state = self.solver.state();
+        let (mut ids, mut x, mut v, mut m) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        if let Some([x0, y0, x1, y1]) = cmd.roi {
+            for (i, p) in state.x.iter().enumerate() {
+                if p[0] >= x0 && p[0] <= x1 && p[1] >= y0 && p[1] <= y1 {
+                    ids.push(i as u32);
+                    x.push(*p);
+                    v.push(state.v[i]);
+                    m.push(state.m[i]);
+                }
+            }
+        }
+        let snapshot = cmd.want_snapshot.then(|| SphSnapshot {
+            x: state.x.clone(),
+            v: state.v.clone(),
+            rho: state.rho.clone(),
+            p: state.p.clone(),
+            m: state.m.clone(),
+            wall_p: self.solver.walls().p.clone(),
+        });
+        Ok(Some(SphState {
+            ids,
+            x,
+            v,
+            m,
+            dt_stable: self.solver.stable_dt(),
+            compute_seconds: started.elapsed().as_secs_f64(),
+            snapshot,
+        }))
+    }
+}

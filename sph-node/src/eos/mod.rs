@@ -1,0 +1,5 @@
+//! Equations of state.
+
+pub mod tait;
+
+pub use tait::Tait;

@@ -1,0 +1,5 @@
+//! Smoothing kernels.
+
+pub mod cubic_spline;
+
+pub use cubic_spline::CubicSpline;

@@ -1,0 +1,5 @@
+//! Neighbour search.
+
+pub mod cell_list;
+
+pub use cell_list::{CellList, NeighborList};

@@ -1,0 +1,29 @@
+//! The SPH node's adapter to the shared serving loop (`cosim_bus::serve`).
+
+use cosim_bus::serve::{Failure, NodeCore};
+use cosim_proto::messages::{SphSetup, SphState, StepCommand};
+
+use crate::core::SphCore;
+use crate::error::SphError;
+
+impl From<SphError> for Failure {
+    fn from(e: SphError) -> Self {
+        Failure {
+            unstable: e.is_unstable(),
+            message: e.to_string(),
+        }
+    }
+}
+
+impl NodeCore for SphCore {
+    type Setup = SphSetup;
+    type State = SphState;
+
+    fn setup(&self) -> &SphSetup {
+        SphCore::setup(self)
+    }
+
+    fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, Failure> {
+        SphCore::handle(self, cmd).map_err(Failure::from)
+    }
+}

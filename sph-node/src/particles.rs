@@ -1,0 +1,91 @@
+//! Particle data: the serializable [`FluidState`] and [`WallParticles`], and the read-only [`ParticleView`] the
+//! physics functions gather from. Per-step scratch lives in the solver, not here.
+
+use serde::{Deserialize, Serialize};
+
+/// The state of the fluid particles at one time level (everything a restart needs besides the scene).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FluidState {
+    /// Time (s).
+    pub t: f64,
+    /// Steps taken.
+    pub step: u64,
+    /// Positions (m).
+    pub x: Vec<[f64; 2]>,
+    /// Velocities (m/s).
+    pub v: Vec<[f64; 2]>,
+    /// Densities (kg/m³).
+    pub rho: Vec<f64>,
+    /// Pressures (Pa).
+    pub p: Vec<f64>,
+    /// Masses (kg) (per unit depth).
+    pub m: Vec<f64>,
+}
+
+impl FluidState {
+    /// Number of fluid particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// Fixed boundary particles of the `[[wall]]` boxes (`DESIGN.md` §4.7). Positions and masses never change;
+/// pressure and density are extrapolated from the fluid every step (Adami et al. 2012).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct WallParticles {
+    /// Positions (m).
+    pub x: Vec<[f64; 2]>,
+    /// Extrapolated pressures (Pa).
+    pub p: Vec<f64>,
+    /// Densities from the inverse EOS (kg/m³).
+    pub rho: Vec<f64>,
+    /// Masses (kg) (ρ0 Δx²).
+    pub m: Vec<f64>,
+}
+
+impl WallParticles {
+    /// Number of wall particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no wall particles.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// All particles, fluid first (indices `0..n_fluid`), then walls, as the gathers see them.
+#[derive(Clone, Copy, Debug)]
+pub struct ParticleView<'a> {
+    /// Positions.
+    pub x: &'a [[f64; 2]],
+    /// Velocities (zero for walls).
+    pub v: &'a [[f64; 2]],
+    /// Densities.
+    pub rho: &'a [f64],
+    /// Pressures.
+    pub p: &'a [f64],
+    /// Masses.
+    pub m: &'a [f64],
+    /// Number of fluid particles.
+    pub n_fluid: usize,
+}
+
+/// r_ij = x_i − x_j and |r_ij|.
+#[inline]
+pub fn separation(xi: [f64; 2], xj: [f64; 2]) -> ([f64; 2], f64) {
+    let r = [xi[0] - xj[0], xi[1] - xj[1]];
+    (r, (r[0] * r[0] + r[1] * r[1]).sqrt())
+}
+
+/// a · b.
+#[inline]
+pub fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}

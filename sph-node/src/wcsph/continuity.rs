@@ -1,0 +1,32 @@
+//! Continuity equation, Eq. (9) of Long et al. 2016: Dρ_i/Dt = ρ_i Σ_j (m_j/ρ_j) (v_i − v_j) · ∇_i W_ij.
+
+use rayon::prelude::*;
+
+use crate::kernel::CubicSpline;
+use crate::neighbors::NeighborList;
+use crate::particles::{dot, separation, ParticleView};
+
+/// Dρ_i/Dt of fluid particle i (wall neighbours included, with their zero velocity).
+#[inline]
+pub fn density_rate(i: usize, view: &ParticleView<'_>, neighbors: &[u32], kernel: &CubicSpline) -> f64 {
+    let (xi, vi) = (view.x[i], view.v[i]);
+    let mut sum = 0.0;
+    for &j in neighbors {
+        let j = j as usize;
+        let (r_ij, r) = separation(xi, view.x[j]);
+        let grad = kernel.grad(r_ij, r);
+        let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
+        // Eq. (9), Long et al. 2016
+        sum += view.m[j] / view.rho[j] * dot(v_ij, grad);
+    }
+    view.rho[i] * sum // Eq. (9), Long et al. 2016
+}
+
+/// Dρ/Dt of every fluid particle into `out` (a parallel gather).
+pub fn density_rates_into(view: &ParticleView<'_>, list: &NeighborList, kernel: &CubicSpline, out: &mut Vec<f64>) {
+    out.clear();
+    (0..view.n_fluid)
+        .into_par_iter()
+        .map(|i| density_rate(i, view, list.of(i), kernel))
+        .collect_into_vec(out);
+}
