@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use cosim_proto::scene;
 use fem_node::core::FemCore;
+use sph_node::core::SphCore;
 
 use crate::cli::CheckArgs;
 
@@ -22,7 +23,14 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             core.mesh().cells.len(),
         )
     };
-    let dt = s.coupling.max_dt.min(s.run.output_interval);
+    let fluid = match &s.fluid {
+        Some(_) => Some(SphCore::new(s).with_context(|| format!("{}: filling the fluid", args.scene.display()))?),
+        None => None,
+    };
+    let (particles, walls, dt_fluid) = fluid.as_ref().map_or((0, 0, f64::INFINITY), |f| {
+        (f.setup().particles as usize, f.setup().walls.len(), f.setup().dt_stable)
+    });
+    let dt = s.coupling.max_dt.min(s.run.output_interval).min(dt_fluid);
     let steps = (s.run.end_time / dt).ceil() as u64;
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
     let frames = (s.run.end_time / s.run.output_interval).ceil() as u64 + 1;
@@ -33,7 +41,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "end_time": s.run.end_time,
             "fem_nodes": nodes,
             "fem_elements": elements,
-            "particles": 0,
+            "particles": particles,
+            "wall_particles": walls,
+            "sph_dt_stable": fluid.as_ref().map(|_| dt_fluid),
             "coupling_dt": dt,
             "coupling_steps": steps,
             "fem_dt_stable": dt_fem,
@@ -67,14 +77,23 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             solid.damping
         );
     }
-    println!("  fluid: none (structure-only run)");
+    match (&s.fluid, &fluid) {
+        (Some(f), Some(core)) => println!(
+            "  fluid: {:?}, {particles} particles + {walls} wall particles, spacing {} m, h = {} m, stable dt {:.3e} s",
+            f.solver,
+            f.spacing,
+            core.setup().h,
+            dt_fluid
+        ),
+        _ => println!("  fluid: none"),
+    }
     match (dt_fem, substeps) {
         (Some(d), Some(k)) => println!(
             "  steps: coupling dt {dt} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
         ),
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
     }
-    println!("  totals: {nodes} FE nodes, {elements} elements, 0 particles");
+    println!("  totals: {nodes} FE nodes, {elements} elements, {particles} particles (coupling steps are estimated from the initial stable step)");
     for p in &s.probes {
         println!("  probe {}: {:?}", p.name, p.kind);
     }
