@@ -97,6 +97,7 @@ pub fn run(scene: &LoadedScene, mut nodes: Nodes<'_>, info: &RunInfo, progress: 
         scene: s.run.name.clone(),
         steps: 0,
         fem_substeps: 0,
+        sph_substeps: 0,
         sim_time: 0.0,
         wall_seconds: 0.0,
         particles: nodes.sph.as_ref().map_or(0, |n| u64::from(n.setup().particles)),
@@ -203,7 +204,12 @@ fn drive(
     while t < end {
         let target = (next_output as f64 * interval).min(end);
         // §3 step 1: the coupling step is the fluid's stable step, capped by the user and the next output time.
-        let cap = s.coupling.max_dt.min(dt_fluid);
+        // Without a structure there is nothing to couple: the fluid node sub-cycles at its own stable step.
+        let cap = if nodes.fem.is_some() {
+            s.coupling.max_dt.min(dt_fluid)
+        } else {
+            s.coupling.max_dt
+        };
         let mut dt = cap.min(target - t);
         let lands = target - (t + dt) <= LANDING * cap;
         if lands {
@@ -216,6 +222,7 @@ fn drive(
         }
         if let Some(state) = &round.sph {
             dt_fluid = state.dt_stable;
+            summary.sph_substeps += u64::from(state.substeps);
         }
         t = if lands { target } else { t + dt };
         summary.steps = step;

@@ -43,6 +43,9 @@ pub struct Summary {
     pub steps: u64,
     /// FEM sub-steps taken.
     pub fem_substeps: u64,
+    /// SPH steps taken.
+    #[serde(default)]
+    pub sph_substeps: u64,
     /// Simulated time reached [s].
     pub sim_time: f64,
     /// Wall time of the run [s].

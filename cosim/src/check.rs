@@ -30,7 +30,13 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let (particles, walls, dt_fluid) = fluid.as_ref().map_or((0, 0, f64::INFINITY), |f| {
         (f.setup().particles as usize, f.setup().walls.len(), f.setup().dt_stable)
     });
-    let dt = s.coupling.max_dt.min(s.run.output_interval).min(dt_fluid);
+    // Fluid-only runs sub-cycle inside the fluid node; only coupled runs step the broker at the fluid's step.
+    let coupled = fluid.is_some() && !s.solids.is_empty();
+    let dt = s
+        .coupling
+        .max_dt
+        .min(s.run.output_interval)
+        .min(if coupled { dt_fluid } else { f64::INFINITY });
     let steps = (s.run.end_time / dt).ceil() as u64;
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
     let frames = (s.run.end_time / s.run.output_interval).ceil() as u64 + 1;
@@ -44,6 +50,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "particles": particles,
             "wall_particles": walls,
             "sph_dt_stable": fluid.as_ref().map(|_| dt_fluid),
+            "sph_steps_estimate": fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil() as u64),
             "coupling_dt": dt,
             "coupling_steps": steps,
             "fem_dt_stable": dt_fem,
@@ -79,11 +86,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     }
     match (&s.fluid, &fluid) {
         (Some(f), Some(core)) => println!(
-            "  fluid: {:?}, {particles} particles + {walls} wall particles, spacing {} m, h = {} m, stable dt {:.3e} s",
+            "  fluid: {:?}, {particles} particles + {walls} wall particles, spacing {} m, h = {:.4} m, stable dt {:.3e} s (about {} steps)",
             f.solver,
             f.spacing,
             core.setup().h,
-            dt_fluid
+            dt_fluid,
+            (s.run.end_time / dt_fluid).ceil()
         ),
         _ => println!("  fluid: none"),
     }

@@ -268,6 +268,7 @@ fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {
         scene: String::new(),
         steps: 0,
         fem_substeps: 0,
+        sph_substeps: 0,
         sim_time: 0.0,
         wall_seconds: wall,
         particles: 0,

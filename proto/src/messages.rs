@@ -165,6 +165,8 @@ pub struct SphState {
     pub v: Vec<[f64; 2]>,
     /// Their masses.
     pub m: Vec<f64>,
+    /// SPH steps taken for this coupling step.
+    pub substeps: u32,
     /// Stable SPH step for the next step [s].
     pub dt_stable: f64,
     /// Seconds of computation this step took on the node.

@@ -42,7 +42,7 @@ impl SphCore {
         &self.solver
     }
 
-    /// Advance by `dt` (in as many equal stable steps as it takes, normally one) and answer. `None` for a stop.
+    /// Advance by `dt` (in as many stable steps as it takes) and answer. `None` for a stop.
     pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, SphError> {
         let started = Instant::now();
         if !cmd.corrections.is_empty() {
@@ -56,11 +56,17 @@ impl SphCore {
         if cmd.stop {
             return Ok(None);
         }
-        if cmd.dt > 0.0 {
-            let k = (cmd.dt / self.solver.stable_dt()).ceil().max(1.0);
-            for _ in 0..k as u64 {
-                self.solver.step(cmd.dt / k)?;
+        let mut substeps = 0u32;
+        // Sub-cycle at the solver's own adaptive stable step (one step when the broker already capped dt by it).
+        let mut done = 0.0;
+        while done < cmd.dt {
+            let mut h = self.solver.stable_dt().min(cmd.dt - done);
+            if cmd.dt - done - h <= 1e-9 * h {
+                h = cmd.dt - done;
             }
+            self.solver.step(h)?;
+            substeps += 1;
+            done += h;
         }
         let state = self.solver.state();
         let (mut ids, mut x, mut v, mut m) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -87,6 +93,7 @@ impl SphCore {
             x,
             v,
             m,
+            substeps,
             dt_stable: self.solver.stable_dt(),
             compute_seconds: started.elapsed().as_secs_f64(),
             snapshot,
