@@ -332,3 +332,59 @@ fn fluid_only_dam_break_runs_as_processes_and_replays_in_process_bit_for_bit() {
     assert_eq!(pvd.matches("<DataSet").count(), 6);
     assert!(a.join("plots/surge_front.svg").is_file());
 }
+
+#[test]
+fn isph_dam_break_replays_in_process_bit_for_bit() {
+    let dir = scratch("isph");
+    let (a, b) = (dir.join("processes"), dir.join("in-process"));
+    let common = [
+        "run",
+        "scenes/dam_break.toml",
+        "--quiet",
+        "--set",
+        "fluid.solver=isph",
+        "--set",
+        "fluid.spacing=0.01",
+        "--set",
+        "run.end_time=0.05",
+        "--set",
+        "run.output_interval=0.01",
+    ];
+    run_ok(
+        &[
+            &common[..],
+            &[
+                "--out",
+                a.to_str().unwrap(),
+                "--run-id",
+                &run_id("isph-a"),
+                "--threads",
+                "2",
+            ],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &[
+            &common[..],
+            &["--out", b.to_str().unwrap(), "--in-process", "--threads", "1"],
+        ]
+        .concat(),
+    );
+    let s = json(&a.join("summary.json"));
+    assert_eq!((s["status"].as_str(), s["solver"].as_str()), (Some("ok"), Some("isph")));
+    let (pa, pb) = (
+        std::fs::read(a.join("probes.csv")).unwrap(),
+        std::fs::read(b.join("probes.csv")).unwrap(),
+    );
+    assert_eq!(pa, pb, "in-process differs from processes");
+    let last: Vec<f64> = String::from_utf8(pa)
+        .unwrap()
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(last[1] > 0.1, "the front moved downstream: {last:?}");
+}

@@ -78,6 +78,16 @@ pub enum DensityFilter {
     Mls,
 }
 
+/// Source term of the ISPH pressure Poisson equation (`DESIGN.md` §4.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PpeSourceKind {
+    /// ∇·u*/Δt (Cummins & Rudman 1999), with a small density-invariant relaxation.
+    DivergenceFree,
+    /// (ρ0 − ρ*)/(ρ0 Δt²) (Shao & Lo 2003).
+    DensityInvariant,
+}
+
 /// `[fluid]` (`DESIGN.md` §5.1).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -113,6 +123,9 @@ pub struct FluidSpec {
     /// APD β; 0 disables.
     #[serde(default = "default_apd")]
     pub apd: f64,
+    /// ISPH pressure Poisson source (isph only); default divergence_free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ppe_source: Option<PpeSourceKind>,
     /// Regions filled with particles at rest (`[[fluid.block]]`).
     #[serde(rename = "block")]
     pub blocks: Vec<BoxSpec>,

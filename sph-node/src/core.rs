@@ -7,19 +7,91 @@ use std::time::Instant;
 use cosim_proto::messages::{SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::Scene;
 
+use cosim_proto::scene::{FluidSolver, PpeSourceKind};
+
 use crate::error::SphError;
-use crate::solver::WcsphSolver;
+use crate::isph::{IsphSolver, PpeSource};
+use crate::particles::{FluidState, WallParticles};
+use crate::solver::{SphParams, WcsphSolver};
+
+/// The fluid solver the scene asks for.
+pub enum Fluid {
+    /// Weakly compressible.
+    Wcsph(WcsphSolver),
+    /// Incompressible (projection).
+    Isph(IsphSolver),
+}
+
+impl Fluid {
+    /// Build the solver of `fluid.solver`.
+    pub fn new(scene: &Scene) -> Result<Self, SphError> {
+        let spec = scene.fluid.as_ref().ok_or_else(|| SphError::InvalidScene {
+            key: "fluid".into(),
+            message: "the scene has no [fluid] section".into(),
+        })?;
+        Ok(match spec.solver {
+            FluidSolver::Wcsph => Fluid::Wcsph(WcsphSolver::new(scene)?),
+            FluidSolver::Isph => Fluid::Isph(IsphSolver::with_source(
+                scene,
+                match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
+                    PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
+                    PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
+                },
+            )?),
+        })
+    }
+
+    /// Particle state.
+    pub fn state(&self) -> &FluidState {
+        match self {
+            Fluid::Wcsph(s) => s.state(),
+            Fluid::Isph(s) => s.state(),
+        }
+    }
+
+    /// Wall particles.
+    pub fn walls(&self) -> &WallParticles {
+        match self {
+            Fluid::Wcsph(s) => s.walls(),
+            Fluid::Isph(s) => s.walls(),
+        }
+    }
+
+    /// Resolved parameters.
+    pub fn params(&self) -> &SphParams {
+        match self {
+            Fluid::Wcsph(s) => s.params(),
+            Fluid::Isph(s) => s.params(),
+        }
+    }
+
+    /// Stable step of the current state.
+    pub fn stable_dt(&self) -> f64 {
+        match self {
+            Fluid::Wcsph(s) => s.stable_dt(),
+            Fluid::Isph(s) => s.stable_dt(),
+        }
+    }
+
+    /// One step.
+    pub fn step(&mut self, dt: f64) -> Result<(), SphError> {
+        match self {
+            Fluid::Wcsph(s) => s.step(dt),
+            Fluid::Isph(s) => s.step(dt),
+        }
+    }
+}
 
 /// A fluid node: the solver plus what it tells the broker.
 pub struct SphCore {
-    solver: WcsphSolver,
+    solver: Fluid,
     setup: SphSetup,
 }
 
 impl SphCore {
     /// Fill the scene's fluid blocks and walls with particles.
     pub fn new(scene: &Scene) -> Result<Self, SphError> {
-        let solver = WcsphSolver::new(scene)?;
+        let solver = Fluid::new(scene)?;
         let params = solver.params();
         let setup = SphSetup {
             particles: solver.state().len() as u32,
@@ -38,7 +110,7 @@ impl SphCore {
     }
 
     /// The solver (tests, checkpoints).
-    pub fn solver(&self) -> &WcsphSolver {
+    pub fn solver(&self) -> &Fluid {
         &self.solver
     }
 

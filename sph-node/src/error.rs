@@ -29,6 +29,16 @@ pub enum SphError {
         /// What went wrong.
         reason: String,
     },
+    /// The ISPH pressure Poisson equation did not converge (`DESIGN.md` §4.3).
+    #[error("PPE not converged at SPH step {step}: relative residual {residual:e} after {iterations} iterations")]
+    PpeNotConverged {
+        /// Number of the step being taken when it failed (`FluidState::step + 1`).
+        step: u64,
+        /// BiCGSTAB iterations done.
+        iterations: usize,
+        /// Relative (Jacobi-preconditioned) residual reached.
+        residual: f64,
+    },
 }
 
 impl SphError {

@@ -10,6 +10,7 @@
 //! * [`time_step`], [`integrator`]: stable step and kick–drift–kick.
 //! * [`particles`]: serializable [`FluidState`] and [`WallParticles`], apart from scratch.
 //! * [`setup`]: particles from the scene; [`solver`]: [`WcsphSolver`].
+//! * [`isph`]: incompressible SPH by projection (§4.3), [`IsphSolver`].
 //!
 //! Every per-particle loop is a gather (each particle sums its own neighbours in a fixed order), so results are
 //! bit-identical for any number of rayon threads.
@@ -21,6 +22,7 @@ pub mod corrections;
 pub mod eos;
 pub mod error;
 pub mod integrator;
+pub mod isph;
 pub mod kernel;
 pub mod neighbors;
 pub mod node;
@@ -31,5 +33,6 @@ pub mod time_step;
 pub mod wcsph;
 
 pub use error::{Result, SphError};
+pub use isph::{IsphSolver, PpeSource};
 pub use particles::{FluidState, WallParticles};
 pub use solver::WcsphSolver;

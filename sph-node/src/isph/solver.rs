@@ -1,0 +1,519 @@
+//! [`IsphSolver`]: the projection method of `DESIGN.md` §4.3 (Cummins & Rudman 1999; Shao & Lo 2003) with
+//! walls as PPE unknowns (Adami et al. 2012, Eq. (27) rows; §4.7) and optional XSPH (§4.4).
+//!
+//! One step of size Δt:
+//! 1. predictor u* = uⁿ + Δt (g + ν∇²uⁿ), x* = xⁿ + Δt u*;
+//! 2. neighbours at x*; free surface (∇·r < 1.5 → p = 0); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
+//! 3. PPE solved by Jacobi-BiCGSTAB warm-started from the last pressures (fluid and walls);
+//! 4. corrector u^{n+1} = u* − Δt (∇p/ρ)_i at x*; x^{n+1} = xⁿ + Δt (uⁿ + u^{n+1})/2 (+ Δt XSPH of u^{n+1}).
+//!
+//! The fluid is incompressible: ρ = ρ0 for fluid and walls throughout.
+
+use cosim_proto::scene::{BoxSpec, FluidSolver, Scene};
+use rayon::prelude::*;
+
+use super::{bicgstab, free_surface, ppe, projection, IsphOptions, PpeSource};
+use crate::boundary::walls;
+use crate::corrections::xsph;
+use crate::eos::Tait;
+use crate::error::{Result, SphError};
+use crate::kernel::CubicSpline;
+use crate::neighbors::{CellList, NeighborList};
+use crate::particles::{FluidState, ParticleView, WallParticles};
+use crate::setup;
+use crate::solver::SphParams;
+
+/// Scratch rebuilt every step: nothing here is state.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    x: Vec<[f64; 2]>,
+    v: Vec<[f64; 2]>,
+    rho: Vec<f64>,
+    p: Vec<f64>,
+    m: Vec<f64>,
+    cells: CellList,
+    list: NeighborList,
+    free: Vec<bool>,
+    source: Vec<f64>,
+    xsph: Vec<[f64; 2]>,
+}
+
+/// What the last PPE solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PpeReport {
+    /// BiCGSTAB iterations.
+    pub iterations: usize,
+    /// Final relative residual (see [`bicgstab`]).
+    pub residual: f64,
+    /// Fluid particles given p = 0 as free surface.
+    pub free_surface: usize,
+}
+
+/// Incompressible SPH solver (projection method).
+#[derive(Clone, Debug)]
+pub struct IsphSolver {
+    params: SphParams,
+    options: IsphOptions,
+    kernel: CubicSpline,
+    state: FluidState,
+    walls: WallParticles,
+    /// sqrt(2 |g| H), H the fluid's depth: the speed scale of Δt while the fluid is slower (§4.2: v_max ≈
+    /// sqrt(2gH)).
+    v_ref: f64,
+    /// Largest |u^{n+1} − uⁿ|/Δt of the last step (|g| before the first).
+    a_max: f64,
+    /// ρ0 Σ_lattice W Δx²: the summation density of a full lattice, the reference of the density-invariant
+    /// source (the cubic spline sum of a lattice is not exactly 1).
+    rho_ref: f64,
+    last_ppe: PpeReport,
+    scratch: Scratch,
+}
+
+impl IsphSolver {
+    /// Builds particles and walls from the scene (`fluid.solver` must be `isph`); divergence-free source.
+    pub fn new(scene: &Scene) -> Result<Self> {
+        Self::with_options(scene, IsphOptions::default())
+    }
+
+    /// As [`IsphSolver::new`] with the given PPE source.
+    pub fn with_source(scene: &Scene, source: PpeSource) -> Result<Self> {
+        Self::with_options(
+            scene,
+            IsphOptions {
+                source,
+                ..IsphOptions::default()
+            },
+        )
+    }
+
+    /// As [`IsphSolver::new`] with all the ISPH options.
+    pub fn with_options(scene: &Scene, options: IsphOptions) -> Result<Self> {
+        let spec = scene.fluid.as_ref().ok_or_else(|| SphError::InvalidScene {
+            key: "fluid".into(),
+            message: "the scene has no [fluid] section".into(),
+        })?;
+        if spec.solver != FluidSolver::Isph {
+            return Err(SphError::InvalidScene {
+                key: "fluid.solver".into(),
+                message: "IsphSolver needs fluid.solver = \"isph\"".into(),
+            });
+        }
+        if !(options.tolerance > 0.0 && options.max_iterations > 0 && options.courant > 0.0) {
+            return Err(SphError::InvalidParameter {
+                name: "isph options",
+                message: format!("tolerance, max_iterations and courant must be positive: {options:?}"),
+            });
+        }
+        let gravity = scene.run.gravity;
+        let dx = spec.spacing;
+        let h = spec.smoothing_ratio * dx;
+        let rho0 = spec.density;
+        // Hydrostatic initial pressure (the warm start of the first PPE); the Tait law only places densities,
+        // which are reset to ρ0.
+        let mut state = setup::initial_state(spec, gravity, &Tait::new(rho0, 1.0));
+        state.rho.iter_mut().for_each(|r| *r = rho0);
+
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for b in spec.blocks.iter().chain(&scene.walls) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(b.min[k]);
+                hi[k] = hi[k].max(b.max[k]);
+            }
+        }
+        let fluid_centre = {
+            let n = state.len().max(1) as f64;
+            let s = state.x.iter().fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]]);
+            [s[0] / n, s[1] / n]
+        };
+        let wall_x = walls::wall_positions(&scene.walls, spec.blocks[0].min, dx, h, fluid_centre);
+        let nw = wall_x.len();
+        let walls = WallParticles {
+            x: wall_x,
+            p: vec![0.0; nw],
+            rho: vec![rho0; nw],
+            m: vec![rho0 * dx * dx; nw],
+        };
+        // Domain: as WcsphSolver, the box around blocks and walls padded by half its largest extent.
+        let pad = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 4.0 * h;
+        let domain = BoxSpec {
+            min: [lo[0] - pad, lo[1] - pad],
+            max: [hi[0] + pad, hi[1] + pad],
+        };
+        let params = SphParams {
+            rho0,
+            dx,
+            h,
+            c0: 0.0, // no sound speed in ISPH
+            nu: spec.kinematic_viscosity,
+            gravity,
+            alpha: 0.0, // no artificial viscosity in ISPH
+            shepard_interval: None,
+            xsph: spec.xsph,
+            domain,
+        };
+        let kernel = CubicSpline::new(h);
+        let rho_ref = {
+            let reach = (2.0 * h / dx).ceil() as i64 + 1;
+            let mut s = 0.0;
+            for iy in -reach..=reach {
+                for ix in -reach..=reach {
+                    s += kernel.w((ix as f64 * dx).hypot(iy as f64 * dx));
+                }
+            }
+            rho0 * s * dx * dx
+        };
+        let mut solver = Self {
+            params,
+            options,
+            kernel,
+            state,
+            walls,
+            a_max: gravity[0].hypot(gravity[1]),
+            v_ref: {
+                let (top, bottom) = setup::fluid_extent(spec);
+                (2.0 * gravity[0].hypot(gravity[1]) * (top - bottom)).sqrt()
+            },
+            rho_ref,
+            last_ppe: PpeReport::default(),
+            scratch: Scratch::default(),
+        };
+        solver.scratch.m = solver.state.m.iter().chain(&solver.walls.m).copied().collect();
+        solver.scratch.rho = vec![rho0; solver.state.len() + nw];
+        solver.scratch.v = vec![[0.0; 2]; solver.state.len() + nw];
+        solver.check(0)?;
+        solver.rebuild_neighbors();
+        Ok(solver)
+    }
+
+    /// Resolved parameters (`c0` and `alpha` are 0: ISPH has neither).
+    pub fn params(&self) -> &SphParams {
+        &self.params
+    }
+
+    /// The ISPH options.
+    pub fn options(&self) -> &IsphOptions {
+        &self.options
+    }
+
+    /// The kernel.
+    pub fn kernel(&self) -> &CubicSpline {
+        &self.kernel
+    }
+
+    /// The fluid state.
+    pub fn state(&self) -> &FluidState {
+        &self.state
+    }
+
+    /// The wall particles, with the pressures of the last PPE solution.
+    pub fn walls(&self) -> &WallParticles {
+        &self.walls
+    }
+
+    /// Iterations, residual and free-surface count of the last PPE solve.
+    pub fn last_ppe(&self) -> PpeReport {
+        self.last_ppe
+    }
+
+    /// Δt = min(C h / max(v_max, sqrt(2 |g| H)), 0.25 sqrt(h/a_max), 0.125 h²/ν) (`DESIGN.md` §4.3, step 6, with
+    /// the force and viscous limits of §4.2; H is the initial fluid depth, a_max the largest acceleration of the
+    /// last step, at least |g|).
+    pub fn stable_dt(&self) -> f64 {
+        let h = self.params.h;
+        let v_max = self
+            .state
+            .v
+            .par_iter()
+            .map(|v| v[0].hypot(v[1]))
+            .reduce(|| 0.0, f64::max);
+        let v = v_max.max(self.v_ref);
+        let mut dt = f64::INFINITY;
+        if v > 0.0 {
+            dt = self.options.courant * h / v; // §4.3 step 6
+        }
+        if self.a_max > 0.0 {
+            dt = dt.min(0.25 * (h / self.a_max).sqrt()); // §4.2 force condition
+        }
+        if self.params.nu > 0.0 {
+            dt = dt.min(0.125 * h * h / self.params.nu); // §4.2 viscous condition
+        }
+        if dt.is_finite() {
+            dt
+        } else {
+            0.25 * h // no motion, no force: any step; keep it finite
+        }
+    }
+
+    /// Σ ½ m |v|² (per unit depth).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.state
+            .v
+            .iter()
+            .zip(&self.state.m)
+            .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
+            .sum()
+    }
+
+    /// Σ −m g · x (per unit depth; zero at the origin).
+    pub fn potential_energy(&self) -> f64 {
+        let g = self.params.gravity;
+        self.state
+            .x
+            .iter()
+            .zip(&self.state.m)
+            .map(|(x, m)| -m * (g[0] * x[0] + g[1] * x[1]))
+            .sum()
+    }
+
+    /// Shepard-normalised SPH interpolation of the fluid pressure at `point` (as
+    /// [`crate::WcsphSolver::sample_pressure`]); `None` when no fluid particle is within 2h.
+    pub fn sample_pressure(&self, point: [f64; 2]) -> Option<f64> {
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.state.len() {
+            let x = self.state.x[i];
+            let r = (point[0] - x[0]).hypot(point[1] - x[1]);
+            let w = self.kernel.w(r) * self.state.m[i] / self.state.rho[i];
+            num += self.state.p[i] * w;
+            den += w;
+        }
+        (den > 0.0).then(|| num / den)
+    }
+
+    /// Advances the fluid by `dt` (predictor, PPE, corrector; see the module documentation).
+    ///
+    /// Errors: [`SphError::PpeNotConverged`] when BiCGSTAB does not reach the tolerance, [`SphError::Unstable`]
+    /// for non-finite values or a particle leaving the domain. After an error the state is part-way through the
+    /// step and should not be advanced further.
+    pub fn step(&mut self, dt: f64) -> Result<()> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(SphError::InvalidParameter {
+                name: "dt",
+                message: format!("must be a positive number, got {dt}"),
+            });
+        }
+        let step_no = self.state.step + 1;
+        let nf = self.state.len();
+        let g = self.params.gravity;
+        let x_n = self.state.x.clone();
+        let v_n = self.state.v.clone();
+
+        // 1. Predictor (Cummins & Rudman 1999, Eq. (13)): u* = uⁿ + Δt (g + ν∇²uⁿ), neighbours of xⁿ.
+        self.scratch.v[..nf].copy_from_slice(&self.state.v);
+        let visc: Vec<[f64; 2]> = {
+            let view = self.view();
+            let (list, kernel, nu) = (&self.scratch.list, &self.kernel, self.params.nu);
+            (0..nf)
+                .into_par_iter()
+                .map(|i| projection::viscous_acceleration(i, &view, list.of(i), kernel, nu))
+                .collect()
+        };
+        let mut v_star = v_n.clone();
+        for (v, a) in v_star.iter_mut().zip(&visc) {
+            v[0] += dt * (g[0] + a[0]);
+            v[1] += dt * (g[1] + a[1]);
+        }
+        // x* = xⁿ + Δt u*
+        for (x, v) in self.state.x.iter_mut().zip(&v_star) {
+            x[0] += dt * v[0];
+            x[1] += dt * v[1];
+        }
+        self.state.v.copy_from_slice(&v_star);
+        self.check(step_no)?;
+        self.rebuild_neighbors();
+        self.scratch.v[..nf].copy_from_slice(&v_star);
+
+        // 2. Free surface and PPE source at x*.
+        let mut free = std::mem::take(&mut self.scratch.free);
+        free_surface::free_surface_into(
+            &self.view(),
+            &self.scratch.list,
+            &self.kernel,
+            self.options.free_surface_threshold,
+            &mut free,
+        );
+        let mut source = std::mem::take(&mut self.scratch.source);
+        source.clear();
+        // Walls carry Δt g for the divergence only (see `projection::velocity_divergence`).
+        for v in &mut self.scratch.v[nf..] {
+            *v = [dt * g[0], dt * g[1]];
+        }
+        {
+            let view = self.view();
+            let (list, kernel) = (&self.scratch.list, &self.kernel);
+            let (rho0, rho_ref) = (self.params.rho0, self.rho_ref);
+            match self.options.source {
+                // Cummins & Rudman 1999, Eq. (15): ∇·(∇p/ρ) = ∇·u*/Δt
+                // + Asai et al. 2012, Eq. (25): γ (ρ0 − ρ*)/(ρ0 Δt²) when density_relaxation γ > 0
+                PpeSource::DivergenceFree => {
+                    let gamma = self.options.density_relaxation;
+                    (0..nf)
+                        .into_par_iter()
+                        .map(|i| {
+                            let div = projection::velocity_divergence(i, &view, list.of(i), kernel) / dt;
+                            if gamma > 0.0 {
+                                let rho_star =
+                                    projection::summation_density(i, &view, list.of(i), kernel) * rho0 / rho_ref;
+                                div + gamma * (rho0 - rho_star) / (rho0 * dt * dt)
+                            } else {
+                                div
+                            }
+                        })
+                        .collect_into_vec(&mut source)
+                }
+                // Shao & Lo 2003, Eq. (14): ∇·(∇p/ρ) = (ρ0 − ρ*)/(ρ0 Δt²), ρ* by summation at x* relative to the
+                // full-lattice sum (ρ* = ρ0 on the initial lattice)
+                PpeSource::DensityInvariant => (0..nf)
+                    .into_par_iter()
+                    .map(|i| {
+                        let rho_star = projection::summation_density(i, &view, list.of(i), kernel) * rho0 / rho_ref;
+                        (rho0 - rho_star) / (rho0 * dt * dt)
+                    })
+                    .collect_into_vec(&mut source),
+            }
+        }
+
+        for v in &mut self.scratch.v[nf..] {
+            *v = [0.0, 0.0];
+        }
+        // 3. PPE (Shao & Lo 2003, Eq. (15); walls: Adami et al. 2012, Eq. (27)), warm-started.
+        let (a, b) = ppe::assemble(&self.view(), &self.scratch.list, &self.kernel, g, &free, &source);
+        let inv_diag: Vec<f64> = a
+            .diagonal()
+            .iter()
+            .map(|&d| if d != 0.0 { 1.0 / d } else { 1.0 })
+            .collect();
+        let mut p: Vec<f64> = self.state.p.iter().chain(&self.walls.p).copied().collect();
+        for (pi, &f) in p.iter_mut().zip(&free) {
+            if f {
+                *pi = 0.0;
+            }
+        }
+        let result = bicgstab::solve(
+            &a,
+            &b,
+            &mut p,
+            &inv_diag,
+            self.options.tolerance,
+            self.options.max_iterations,
+        );
+        let n_free = free.iter().filter(|&&f| f).count();
+        self.scratch.free = free;
+        self.scratch.source = source;
+        let stats = match result {
+            Ok(s) => s,
+            Err(s) => {
+                return Err(SphError::PpeNotConverged {
+                    step: step_no,
+                    iterations: s.iterations,
+                    residual: s.residual,
+                })
+            }
+        };
+        self.last_ppe = PpeReport {
+            iterations: stats.iterations,
+            residual: stats.residual,
+            free_surface: n_free,
+        };
+        if let Some(i) = p.iter().position(|p| !p.is_finite()) {
+            return Err(self.unstable(step_no, i.min(nf.saturating_sub(1)), "non-finite PPE pressure".into()));
+        }
+        // Negative pressures are clipped to 0 after the linear solve: walls never pull the fluid (Adami et al.
+        // 2012, as `boundary::adami`; wall particles above the free surface extrapolate below 0), and negative
+        // fluid pressures (tensile instability of the symmetric gradient) are set to 0 as is usual in free-surface
+        // ISPH (Shao & Lo 2003 treat the surface as p = 0). Without this the still-water tank blows up in 0.6 s.
+        for pi in &mut p {
+            *pi = pi.max(0.0);
+        }
+        self.state.p.copy_from_slice(&p[..nf]);
+        self.walls.p.copy_from_slice(&p[nf..]);
+        self.scratch.p.clear();
+        self.scratch.p.extend_from_slice(&p);
+
+        // 4. Corrector (Cummins & Rudman 1999, Eq. (16)): u^{n+1} = u* − Δt (∇p/ρ)_i at x*.
+        let grad: Vec<[f64; 2]> = {
+            let view = self.view();
+            let (list, kernel) = (&self.scratch.list, &self.kernel);
+            (0..nf)
+                .into_par_iter()
+                .map(|i| projection::pressure_gradient(i, &view, list.of(i), kernel))
+                .collect()
+        };
+        for (v, gp) in self.state.v.iter_mut().zip(&grad) {
+            v[0] -= dt * gp[0];
+            v[1] -= dt * gp[1];
+        }
+        // XSPH (§4.4) of u^{n+1}, gathered at x*.
+        let mut corr = std::mem::take(&mut self.scratch.xsph);
+        corr.clear();
+        if self.params.xsph > 0.0 {
+            self.scratch.v[..nf].copy_from_slice(&self.state.v);
+            xsph::xsph_into(
+                &self.view(),
+                &self.scratch.list,
+                &self.kernel,
+                self.params.xsph,
+                &mut corr,
+            );
+        }
+        // §4.3 step 5: x^{n+1} = xⁿ + Δt (uⁿ + u^{n+1})/2
+        let mut a_max: f64 = 0.0;
+        for i in 0..nf {
+            let (v0, v1) = (v_n[i], self.state.v[i]);
+            let c = corr.get(i).copied().unwrap_or([0.0; 2]);
+            self.state.x[i] = [
+                x_n[i][0] + dt * (0.5 * (v0[0] + v1[0]) + c[0]),
+                x_n[i][1] + dt * (0.5 * (v0[1] + v1[1]) + c[1]),
+            ];
+            a_max = a_max.max((v1[0] - v0[0]).hypot(v1[1] - v0[1]) / dt);
+        }
+        self.scratch.xsph = corr;
+        self.a_max = a_max.max(g[0].hypot(g[1]));
+        self.check(step_no)?;
+        self.rebuild_neighbors();
+        self.state.t += dt;
+        self.state.step = step_no;
+        Ok(())
+    }
+
+    fn rebuild_neighbors(&mut self) {
+        let s = &mut self.scratch;
+        s.x.clear();
+        s.x.extend_from_slice(&self.state.x);
+        s.x.extend_from_slice(&self.walls.x);
+        s.cells.rebuild(&s.x, self.kernel.support());
+        s.list = s.cells.neighbor_list(&s.x, s.x.len(), self.kernel.support());
+        s.p.clear();
+        s.p.extend_from_slice(&self.state.p);
+        s.p.extend_from_slice(&self.walls.p);
+    }
+
+    fn view(&self) -> ParticleView<'_> {
+        let s = &self.scratch;
+        ParticleView {
+            x: &s.x,
+            v: &s.v,
+            rho: &s.rho,
+            p: &s.p,
+            m: &s.m,
+            n_fluid: self.state.len(),
+        }
+    }
+
+    /// Non-finite or out-of-domain positions and velocities.
+    fn check(&self, step: u64) -> Result<()> {
+        let d = &self.params.domain;
+        for (i, (x, v)) in self.state.x.iter().zip(&self.state.v).enumerate() {
+            if !(x[0].is_finite() && x[1].is_finite() && v[0].is_finite() && v[1].is_finite()) {
+                return Err(self.unstable(step, i, "non-finite position or velocity".into()));
+            }
+            if !d.contains(*x) {
+                return Err(self.unstable(step, i, format!("left the domain at {x:?}")));
+            }
+        }
+        Ok(())
+    }
+
+    fn unstable(&self, step: u64, particle: usize, reason: String) -> SphError {
+        SphError::Unstable { step, particle, reason }
+    }
+}
