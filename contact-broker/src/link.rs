@@ -77,10 +77,13 @@ pub type FemLink = dyn NodeLink<Setup = FemMesh, State = FemState>;
 /// The fluid node.
 pub type SphLink = dyn NodeLink<Setup = SphSetup, State = SphState>;
 
+/// A node's step handler: the answer to a command, `None` for a stop.
+type Handler<T> = Box<dyn FnMut(&StepCommand) -> Result<Option<T>, LinkError>>;
+
 /// A node in this process: a handler called when its answer is asked for.
 pub struct InProcess<S, T> {
     setup: S,
-    handler: Box<dyn FnMut(&StepCommand) -> Result<Option<T>, LinkError>>,
+    handler: Handler<T>,
     pending: Option<StepCommand>,
 }
 

@@ -244,14 +244,18 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         Some(summary) => Ok(summary),
         None => {
             // The broker died before it could write one: write what we know.
+            // The broker's last line already carries a node's report when one came in; else the nodes' logs.
+            let broker_said = last_line(&broker_log);
             let message = if broker_status.success() {
                 "contact-broker exited without a summary".to_string()
+            } else if let Some(reason) = broker_said.strip_prefix("contact-broker: ") {
+                reason.to_string()
             } else {
                 let nodes: Vec<String> = wanted
                     .iter()
-                    .map(|n| format!("{n}: {}", last_line(&logs.join(format!("{n}.log")))))
+                    .map(|n| last_line(&logs.join(format!("{n}.log"))))
                     .collect();
-                format!("contact-broker: {}; {}", last_line(&broker_log), nodes.join("; "))
+                format!("contact-broker: {broker_said}; {}", nodes.join("; "))
             };
             let summary = failed_summary(info, message, started.elapsed().as_secs_f64());
             write_summary(&info.out, &summary)?;

@@ -1,5 +1,5 @@
 //! [`WcsphSolver`]: the WCSPH pipeline of `DESIGN.md` §4.2 (Eqs. (9)–(12)) with Adami walls (§4.7), the Shepard
-//! filter and XSPH (§4.4), advanced by kick–drift–kick.
+//! or first-order MLS density filter, XSPH and APD (§4.4), advanced by kick–drift–kick.
 //!
 //! The solver owns the serializable [`FluidState`] and [`WallParticles`] and scratch that is rebuilt every step
 //! (combined particle arrays, cell list, neighbour lists, rates).
@@ -8,7 +8,7 @@ use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
 
 use crate::boundary::{adami, walls};
-use crate::corrections::{density_filter, xsph};
+use crate::corrections::{apd, density_filter, mls, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::integrator;
@@ -36,12 +36,25 @@ pub struct SphParams {
     pub gravity: [f64; 2],
     /// α_π of Eq. (11).
     pub alpha: f64,
-    /// Shepard filter interval in steps (`None`: off).
+    /// Density filter interval in steps (`None`: off); the filter (Shepard or MLS) is chosen by
+    /// [`WcsphOptions::mls`].
     pub shepard_interval: Option<u32>,
     /// XSPH ε (0: off).
     pub xsph: f64,
     /// A fluid particle outside this box is unstable.
     pub domain: BoxSpec,
+}
+
+/// WCSPH settings beyond [`SphParams`] (kept apart so that `SphParams` stays shared with other solvers).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WcsphOptions {
+    /// The density filter passes (every [`SphParams::shepard_interval`] steps) use the first-order MLS filter
+    /// (Colagrossi & Landrini 2003) instead of Shepard's.
+    pub mls: bool,
+    /// APD β (0: off; §4.4, Xu et al. 2009).
+    pub apd: f64,
+    /// Central body force a = −k x (k = Ω², Monaghan & Rafiee 2013 oscillating drop); 0 for scenes.
+    pub central_force: f64,
 }
 
 /// Scratch rebuilt every step: nothing here is state.
@@ -58,6 +71,7 @@ struct Scratch {
     drho: Vec<f64>,
     filtered: Vec<f64>,
     xsph: Vec<[f64; 2]>,
+    shift: Vec<[f64; 2]>,
     wall: Vec<(f64, f64)>,
 }
 
@@ -65,6 +79,7 @@ struct Scratch {
 #[derive(Clone, Debug)]
 pub struct WcsphSolver {
     params: SphParams,
+    options: WcsphOptions,
     kernel: CubicSpline,
     eos: Tait,
     state: FluidState,
@@ -87,13 +102,13 @@ impl WcsphSolver {
         }
         let shepard_interval = match spec.density_filter() {
             DensityFilter::None => None,
-            DensityFilter::Shepard => Some(spec.density_filter_interval),
-            DensityFilter::Mls => {
+            DensityFilter::Shepard | DensityFilter::Mls if spec.density_filter_interval == 0 => {
                 return Err(SphError::InvalidScene {
-                    key: "fluid.density_filter".into(),
-                    message: "the mls filter is not implemented; use shepard or none".into(),
+                    key: "fluid.density_filter_interval".into(),
+                    message: "must be at least 1 step".into(),
                 })
             }
+            DensityFilter::Shepard | DensityFilter::Mls => Some(spec.density_filter_interval),
         };
         let gravity = scene.run.gravity;
         let dx = spec.spacing;
@@ -140,9 +155,45 @@ impl WcsphSolver {
             xsph: spec.xsph,
             domain,
         };
+        let options = WcsphOptions {
+            mls: spec.density_filter() == DensityFilter::Mls,
+            // The scene's default is 0 for now: with β = 0.04 still water develops an interior pressure error
+            // (particles pair up at Δx/2 mid-depth; 11 % at mid-depth after 2 s).
+            apd: spec.apd,
+            central_force: 0.0,
+        };
+        Self::from_particles(params, options, state, walls)
+    }
+
+    /// A solver on given particles (tests, e.g. the oscillating drop, whose circle the scene's blocks cannot
+    /// describe): the Tait law follows from `params.rho0` and `params.c0`, the kernel from `params.h`. The
+    /// state's ρ and v are taken as given (p is recomputed from ρ); wall p and ρ are re-extrapolated.
+    pub fn from_particles(
+        params: SphParams,
+        options: WcsphOptions,
+        state: FluidState,
+        walls: WallParticles,
+    ) -> Result<Self> {
+        let n = state.len();
+        if state.v.len() != n || state.rho.len() != n || state.m.len() != n || state.p.len() != n {
+            return Err(SphError::InvalidParameter {
+                name: "state",
+                message: "x, v, rho, p and m must have the same length".into(),
+            });
+        }
+        let nw = walls.len();
+        if walls.p.len() != nw || walls.rho.len() != nw || walls.m.len() != nw {
+            return Err(SphError::InvalidParameter {
+                name: "walls",
+                message: "x, p, rho and m must have the same length".into(),
+            });
+        }
+        let eos = Tait::new(params.rho0, params.c0);
+        let kernel = CubicSpline::new(params.h);
         let mut solver = Self {
             params,
-            kernel: CubicSpline::new(h),
+            options,
+            kernel,
             eos,
             state,
             walls,
@@ -159,6 +210,16 @@ impl WcsphSolver {
     /// Resolved parameters.
     pub fn params(&self) -> &SphParams {
         &self.params
+    }
+
+    /// WCSPH options (density filter kind, APD β, central force).
+    pub fn options(&self) -> &WcsphOptions {
+        &self.options
+    }
+
+    /// Sets the APD β (§4.4; 0 disables) for the following steps.
+    pub fn set_apd(&mut self, beta: f64) {
+        self.options.apd = beta;
     }
 
     /// The kernel.
@@ -274,18 +335,52 @@ impl WcsphSolver {
         integrator::drift(&mut self.state.x, &self.state.v, &corr, dt);
         self.scratch.xsph = corr;
         self.check(step_no)?;
-        // Rates at the new positions.
         self.rebuild_neighbors();
+        // APD after the drift (§4.4; Xu et al. 2009, Eq. (35)), then the neighbours of the shifted positions.
+        if self.options.apd > 0.0 {
+            let v_max = self
+                .state
+                .v
+                .par_iter()
+                .map(|v| v[0].hypot(v[1]))
+                .reduce(|| 0.0, f64::max);
+            if v_max > 0.0 {
+                self.sync_fluid();
+                let apd_params = apd::ApdParams {
+                    beta: self.options.apd,
+                    v_max,
+                    dt,
+                };
+                let mut shift = std::mem::take(&mut self.scratch.shift);
+                apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &apd_params, &mut shift);
+                // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
+                let mut drho = std::mem::take(&mut self.scratch.filtered);
+                apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
+                self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+                self.scratch.filtered = drho;
+                integrator::drift(&mut self.state.x, &shift, &[], 1.0);
+                self.scratch.shift = shift;
+                self.check(step_no)?;
+                self.rebuild_neighbors();
+            }
+        }
+        // Rates at the new positions.
         self.sync_fluid();
         let mut drho = std::mem::take(&mut self.scratch.drho);
         continuity::density_rates_into(&self.view(), &self.scratch.list, &self.kernel, &mut drho);
         self.scratch.drho = drho;
         integrator::half_kick_density(&mut self.state.rho, &self.scratch.drho, dt);
         if let Some(n) = self.params.shepard_interval {
-            if step_no % n as u64 == 0 {
+            if step_no % u64::from(n.max(1)) == 0 {
                 self.sync_fluid();
                 let mut filtered = std::mem::take(&mut self.scratch.filtered);
-                density_filter::shepard_into(&self.view(), &self.scratch.list, &self.kernel, &mut filtered);
+                if self.options.mls {
+                    // §4.4 first-order MLS filter (Colagrossi & Landrini 2003, Eqs. (20)–(22))
+                    mls::mls_into(&self.view(), &self.scratch.list, &self.kernel, &mut filtered);
+                } else {
+                    // §4.4 Shepard filter
+                    density_filter::shepard_into(&self.view(), &self.scratch.list, &self.kernel, &mut filtered);
+                }
                 self.state.rho.copy_from_slice(&filtered);
                 self.scratch.filtered = filtered;
             }
@@ -343,6 +438,14 @@ impl WcsphSolver {
         };
         let mut accel = std::mem::take(&mut self.scratch.accel);
         momentum::accelerations_into(&self.view(), &self.scratch.list, &self.kernel, &params, &mut accel);
+        let k = self.options.central_force;
+        if k != 0.0 {
+            // Monaghan & Rafiee 2013: central body force f = −Ω² r
+            accel.par_iter_mut().zip(self.state.x.par_iter()).for_each(|(a, x)| {
+                a[0] -= k * x[0];
+                a[1] -= k * x[1];
+            });
+        }
         self.scratch.accel = accel;
     }
 

@@ -3,8 +3,6 @@
 
 mod common;
 
-use std::time::Instant;
-
 use sph_node::WcsphSolver;
 
 const A: f64 = 0.1;
@@ -70,34 +68,4 @@ fn surge_front_against_martin_moyce() {
     // the experiment (no gate-opening time, no wall friction), so this is NOT a 5 % validation; it is a 20 %
     // regression guard on the measured behaviour.
     assert!(worst < 0.20, "worst error {worst}");
-}
-
-/// Particle-steps per second on a ~20,000-particle dam break, single thread (measured, not asserted).
-#[test]
-#[ignore]
-fn throughput_single_thread() {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
-    pool.install(|| {
-        let a = 0.4;
-        let dx = a / 100.0; // 100 × 200 = 20,000 fluid particles
-        let scene = common::dam_break(a, 5.0 * a, dx, "");
-        let mut solver = WcsphSolver::new(&scene).expect("solver");
-        for _ in 0..5 {
-            let dt = solver.stable_dt();
-            solver.step(dt).expect("stable");
-        }
-        let steps = 100;
-        let start = Instant::now();
-        for _ in 0..steps {
-            let dt = solver.stable_dt();
-            solver.step(dt).expect("stable");
-        }
-        let secs = start.elapsed().as_secs_f64();
-        let n = solver.state().len();
-        eprintln!(
-            "{n} fluid + {} wall particles, {steps} steps in {secs:.2} s: {:.3e} fluid particle-steps/s",
-            solver.walls().len(),
-            (n * steps) as f64 / secs
-        );
-    });
 }
