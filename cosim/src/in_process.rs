@@ -1,38 +1,28 @@
-//! Every node in this process: the coordinator calls the nodes' handlers directly.
+//! Every node in this process: the coordinator calls the nodes' handlers directly — the same handlers the node
+//! binaries serve over zenoh (`cosim_bus::serve::NodeCore`).
 
-use contact_broker::link::{InProcess, LinkError};
-use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
-use fem_node::core::FemCore;
-use sph_node::core::SphCore;
+use contact_broker::link::{InProcess, LinkError, Reply};
+use cosim_bus::serve::NodeCore;
 
-/// The structure node, in this process.
-pub fn fem(core: FemCore) -> InProcess<FemMesh, FemState> {
-    let setup = core.mesh().clone();
-    let mut core = core;
-    InProcess::new(setup, move |cmd| {
-        core.handle(cmd).map_err(|e| {
-            let (node, message) = ("fem-node".to_string(), e.to_string());
-            if e.is_unstable() {
-                LinkError::Unstable { node, message }
-            } else {
-                LinkError::Failed { node, message }
-            }
-        })
-    })
-}
-
-/// The fluid node, in this process.
-pub fn sph(core: SphCore) -> InProcess<SphSetup, SphState> {
+/// A node, in this process; `name` labels its errors.
+pub fn link<C>(name: &'static str, core: C) -> InProcess<C::Setup, C::State>
+where
+    C: NodeCore + 'static,
+    C::Setup: Clone,
+    C::State: Reply,
+{
     let setup = core.setup().clone();
     let mut core = core;
     InProcess::new(setup, move |cmd| {
-        core.handle(cmd).map_err(|e| {
-            let (node, message) = ("sph-node".to_string(), e.to_string());
-            if e.is_unstable() {
-                LinkError::Unstable { node, message }
-            } else {
-                LinkError::Failed { node, message }
-            }
+        core.handle(cmd).map_err(|f| match f.unstable {
+            true => LinkError::Unstable {
+                node: name.into(),
+                message: f.message,
+            },
+            false => LinkError::Failed {
+                node: name.into(),
+                message: f.message,
+            },
         })
     })
 }

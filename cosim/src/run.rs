@@ -104,11 +104,17 @@ fn run_in_process(
         rayon_threads(n)?;
     }
     let mut fem = match scene.scene.solids.is_empty() {
-        false => Some(in_process::fem(FemCore::new(&scene.scene).context("fem-node")?)),
+        false => Some(in_process::link(
+            "fem-node",
+            FemCore::new(&scene.scene).context("fem-node")?,
+        )),
         true => None,
     };
     let mut sph = match scene.scene.fluid {
-        Some(_) => Some(in_process::sph(SphCore::new(&scene.scene).context("sph-node")?)),
+        Some(_) => Some(in_process::link(
+            "sph-node",
+            SphCore::new(&scene.scene).context("sph-node")?,
+        )),
         None => None,
     };
     let nodes = Nodes {
