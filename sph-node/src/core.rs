@@ -13,6 +13,7 @@ use crate::error::SphError;
 use crate::isph::{IsphSolver, PpeSource};
 use crate::particles::{FluidState, WallParticles};
 use crate::solver::{SphParams, WcsphSolver};
+use crate::stability::EnergyGuard;
 
 /// The fluid solver the scene asks for.
 pub enum Fluid {
@@ -86,6 +87,7 @@ impl Fluid {
 pub struct SphCore {
     solver: Fluid,
     setup: SphSetup,
+    guard: EnergyGuard,
 }
 
 impl SphCore {
@@ -101,7 +103,8 @@ impl SphCore {
             walls: solver.walls().x.clone(),
             dt_stable: solver.stable_dt(),
         };
-        Ok(Self { solver, setup })
+        let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity);
+        Ok(Self { solver, setup, guard })
     }
 
     /// The `sph/setup` registration message.
@@ -139,6 +142,9 @@ impl SphCore {
             self.solver.step(h)?;
             substeps += 1;
             done += h;
+        }
+        if substeps > 0 {
+            self.guard.check(self.solver.state())?;
         }
         let state = self.solver.state();
         let (mut ids, mut x, mut v, mut m) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());

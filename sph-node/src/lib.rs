@@ -29,6 +29,7 @@ pub mod node;
 pub mod particles;
 pub mod setup;
 pub mod solver;
+pub mod stability;
 pub mod time_step;
 pub mod wcsph;
 
