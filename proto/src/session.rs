@@ -1,4 +1,4 @@
-//! The zenoh session settings every node uses, as `(key, json5 value)` pairs for `zenoh::Config::insert_json5`,
+//! The zenoh session settings every node uses, as `(key, json5 value)` pairs for zenoh's `Config::insert_json5`,
 //! so that no crate but the node adapters depends on zenoh.
 
 /// Settings of a peer session: multicast scouting off (gossip stays on so peers that only know a hub find each
