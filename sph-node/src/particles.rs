@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::kernel::CubicSpline;
+
 /// The state of the fluid particles at one time level (everything a restart needs besides the scene).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FluidState {
@@ -31,6 +33,40 @@ impl FluidState {
     /// True when there are no particles.
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// ½ m |v|² of particle `i` (per unit depth).
+    pub fn kinetic_energy_of(&self, i: usize) -> f64 {
+        let v = self.v[i];
+        0.5 * self.m[i] * (v[0] * v[0] + v[1] * v[1])
+    }
+
+    /// Σ ½ m |v|² (per unit depth).
+    pub fn kinetic_energy(&self) -> f64 {
+        (0..self.len()).map(|i| self.kinetic_energy_of(i)).sum()
+    }
+
+    /// Σ −m g · x (per unit depth; zero at the origin).
+    pub fn potential_energy(&self, g: [f64; 2]) -> f64 {
+        self.x
+            .iter()
+            .zip(&self.m)
+            .map(|(x, m)| -m * (g[0] * x[0] + g[1] * x[1]))
+            .sum()
+    }
+
+    /// Shepard-normalised SPH interpolation of the fluid pressure at `point`,
+    /// Σ_f p_f (m_f/ρ_f) W / Σ_f (m_f/ρ_f) W; `None` when no fluid particle is within 2h.
+    pub fn sample_pressure(&self, kernel: &CubicSpline, point: [f64; 2]) -> Option<f64> {
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.len() {
+            let x = self.x[i];
+            let r = (point[0] - x[0]).hypot(point[1] - x[1]);
+            let w = kernel.w(r) * self.m[i] / self.rho[i];
+            num += self.p[i] * w;
+            den += w;
+        }
+        (den > 0.0).then(|| num / den)
     }
 }
 

@@ -266,37 +266,18 @@ impl WcsphSolver {
 
     /// Σ ½ m |v|² (per unit depth).
     pub fn kinetic_energy(&self) -> f64 {
-        self.state
-            .v
-            .iter()
-            .zip(&self.state.m)
-            .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1]))
-            .sum()
+        self.state.kinetic_energy()
     }
 
     /// Σ −m g · x (per unit depth; zero at the origin).
     pub fn potential_energy(&self) -> f64 {
-        let g = self.params.gravity;
-        self.state
-            .x
-            .iter()
-            .zip(&self.state.m)
-            .map(|(x, m)| -m * (g[0] * x[0] + g[1] * x[1]))
-            .sum()
+        self.state.potential_energy(self.params.gravity)
     }
 
-    /// Shepard-normalised SPH interpolation of the fluid pressure at `point`,
-    /// Σ_f p_f (m_f/ρ_f) W / Σ_f (m_f/ρ_f) W; `None` when no fluid particle is within 2h.
+    /// Shepard-normalised SPH interpolation of the fluid pressure at `point`; `None` when no fluid particle is
+    /// within 2h.
     pub fn sample_pressure(&self, point: [f64; 2]) -> Option<f64> {
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..self.state.len() {
-            let x = self.state.x[i];
-            let r = (point[0] - x[0]).hypot(point[1] - x[1]);
-            let w = self.kernel.w(r) * self.state.m[i] / self.state.rho[i];
-            num += self.state.p[i] * w;
-            den += w;
-        }
-        (den > 0.0).then(|| num / den)
+        self.state.sample_pressure(&self.kernel, point)
     }
 
     /// Advances the fluid by `dt` (kick–drift–kick, see [`integrator`]).

@@ -13,12 +13,6 @@ pub struct EnergyGuard {
     pub bound: f64,
 }
 
-/// ½ m |v|² of particle `i`.
-fn kinetic(state: &FluidState, i: usize) -> f64 {
-    let v = state.v[i];
-    0.5 * state.m[i] * (v[0] * v[0] + v[1] * v[1])
-}
-
 impl EnergyGuard {
     /// The budget of the initial state: kinetic energy plus the potential energy above the lowest level any
     /// particle (fluid or wall) occupies, doubled for margin.
@@ -31,8 +25,7 @@ impl EnergyGuard {
             .zip(&state.m)
             .map(|(x, m)| m * (height(x) - lowest))
             .sum();
-        let kinetic: f64 = (0..state.len()).map(|i| kinetic(state, i)).sum();
-        let budget = kinetic + potential;
+        let budget = state.kinetic_energy() + potential;
         Self {
             bound: if budget > 0.0 { 2.0 * budget } else { f64::INFINITY },
         }
@@ -40,12 +33,12 @@ impl EnergyGuard {
 
     /// `Unstable` naming the most energetic particle when the kinetic energy exceeds the bound.
     pub fn check(&self, state: &FluidState) -> Result<(), SphError> {
-        let total: f64 = (0..state.len()).map(|i| kinetic(state, i)).sum();
+        let total = state.kinetic_energy();
         if total <= self.bound {
             return Ok(());
         }
         let particle = (0..state.len())
-            .max_by(|&a, &b| kinetic(state, a).total_cmp(&kinetic(state, b)))
+            .max_by(|&a, &b| state.kinetic_energy_of(a).total_cmp(&state.kinetic_energy_of(b)))
             .unwrap_or(0);
         Err(SphError::Unstable {
             step: state.step,
