@@ -317,7 +317,7 @@ fn fluid_only_dam_break_runs_as_processes_and_replays_in_process_bit_for_bit() {
     let csv = String::from_utf8(pa).unwrap();
     assert_eq!(
         csv.lines().next().unwrap(),
-        "t,surge_front,column_height,p_floor,energy"
+        "t,surge_front,surge_front_mps,column_height,p_floor,energy"
     );
     let rows: Vec<Vec<f64>> = csv
         .lines()
