@@ -10,6 +10,7 @@ use anyhow::Context;
 use cosim_proto::messages::{FemState, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{LoadedScene, SceneError};
 
+use crate::interface::{Corrections, Interface, PassStats};
 use crate::link::{FemLink, LinkError, Reply, SphLink};
 use crate::output::{plot_probe, FrameWriter, PointField, ProbeCsv};
 use crate::probes::Probes;
@@ -45,8 +46,7 @@ pub struct Outcome {
     pub error: Option<anyhow::Error>,
 }
 
-/// What this build can run: structure-only and fluid-only scenes. Contact between the two is not wired into the
-/// coordinator yet, so a scene with both is refused up front with the key that asks for it.
+/// Scenes this coordinator refuses up front, with the key that makes them meaningless.
 pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
     let refuse = |key: &str, message: &str| {
         Err(SceneError {
@@ -56,12 +56,6 @@ pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
         })
     };
     let s = &scene.scene;
-    if s.fluid.is_some() && !s.solids.is_empty() {
-        return refuse(
-            "solid",
-            "this build runs structure-only or fluid-only scenes; fluid-structure contact is not part of the run yet",
-        );
-    }
     if s.fluid.is_none() && !s.walls.is_empty() {
         return refuse("wall", "walls hold water: a scene with [[wall]] needs a [fluid]");
     }
@@ -107,7 +101,11 @@ pub fn run(scene: &LoadedScene, mut nodes: Nodes<'_>, info: &RunInfo, progress: 
             .fluid
             .as_ref()
             .map_or("none".into(), |f| format!("{:?}", f.solver).to_lowercase()),
-        contact: "none".into(),
+        contact: if s.fluid.is_some() && !s.solids.is_empty() {
+            s.contact.algorithm.name().into()
+        } else {
+            "none".into()
+        },
         mode: info.mode.clone(),
         frames: 0,
         samples: 0,
@@ -167,7 +165,12 @@ fn drive(
     let mut csv = ProbeCsv::create(&info.out.join("probes.csv"), probes.names())?;
     let interval = s.run.output_interval;
     let end = s.run.end_time;
-    let mut sample = |t: f64, round: &Round, nodes: &Nodes<'_>, summary: &mut Summary| -> anyhow::Result<()> {
+    let mut sample = |t: f64,
+                      round: &Round,
+                      nodes: &Nodes<'_>,
+                      load: Option<&[[f64; 2]]>,
+                      summary: &mut Summary|
+     -> anyhow::Result<()> {
         let started = Instant::now();
         let fem = match (&nodes.fem, &round.fem) {
             (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "fem-node")?)),
@@ -184,7 +187,7 @@ fn drive(
         }
         let index = summary.frames as usize;
         if let Some((mesh, snap)) = fem {
-            frames.write_structure(index, t, mesh, snap)?;
+            frames.write_structure(index, t, mesh, snap, load)?;
         }
         if let Some((setup, snap)) = sph {
             write_particles(&mut frames, index, t, setup, snap)?;
@@ -195,10 +198,25 @@ fn drive(
         Ok(())
     };
 
+    // DESIGN.md §3: with both a structure and a fluid the broker runs the contact pass between steps.
+    let mut interface = match (&nodes.fem, &nodes.sph) {
+        (Some(f), Some(p)) => Some(Interface::new(s, f.setup(), p.setup())),
+        _ => None,
+    };
+    let mut roi = interface.as_ref().map(|i| {
+        let mesh = nodes.fem.as_ref().expect("interface has a structure").setup();
+        let x: Vec<[f64; 2]> = i.node_ids().iter().map(|&id| mesh.nodes[id as usize]).collect();
+        i.roi(&x)
+    });
+    let mut pending = Corrections::default();
+    let mut load = None;
+    let mut exchanged = 0u64;
+
     let mut t = 0.0;
     let mut step = 0u64;
-    let round = exchange(nodes, summary, step, t, command(0.0, true, false))?;
-    sample(t, &round, nodes, summary)?;
+    let coupled = interface.is_some();
+    let round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
+    sample(t, &round, nodes, load.as_deref(), summary)?;
     let mut dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
     let mut next_output = 1u64;
     while t < end {
@@ -216,7 +234,7 @@ fn drive(
             dt = target - t;
         }
         step += 1;
-        let round = exchange(nodes, summary, step, t, command(dt, lands, false))?;
+        let round = exchange(nodes, summary, step, t, commands(dt, lands, coupled, roi, &mut pending))?;
         if let Some(state) = &round.fem {
             summary.fem_substeps += u64::from(state.substeps);
         }
@@ -227,8 +245,23 @@ fn drive(
         t = if lands { target } else { t + dt };
         summary.steps = step;
         summary.sim_time = t;
+        // §3 step 4: contact on the states just reported; the corrections go out with the next command.
+        if let (Some(interface), Some(fem), Some(sph)) = (interface.as_mut(), &round.fem, &round.sph) {
+            let started = Instant::now();
+            let (corrections, stats) = interface
+                .pass(fem, sph, dt)
+                .with_context(|| format!("contact pass of coupling step {step} at t = {t} s"))?;
+            pending = corrections;
+            roi = Some(interface.roi(&fem.x));
+            exchanged += stats.exchanged as u64;
+            record(&mut summary.contact_stats, &stats, exchanged, step);
+            if lands {
+                load = Some(interface.load());
+            }
+            summary.timings.broker += started.elapsed().as_secs_f64();
+        }
         if lands {
-            sample(t, &round, nodes, summary)?;
+            sample(t, &round, nodes, load.as_deref(), summary)?;
             if target >= next_output as f64 * interval {
                 next_output += 1;
             }
@@ -254,6 +287,39 @@ fn command(dt: f64, want_snapshot: bool, stop: bool) -> StepCommand {
         want_snapshot,
         stop,
     }
+}
+
+/// The commands of one step, (fem, sph): the pending corrections go to their node; the fluid node is asked for
+/// the particles inside `roi`, the structure node for its interface nodes, when the run is coupled.
+fn commands(
+    dt: f64,
+    want_snapshot: bool,
+    coupled: bool,
+    roi: Option<[f64; 4]>,
+    pending: &mut Corrections,
+) -> (StepCommand, StepCommand) {
+    let fem = StepCommand {
+        corrections: std::mem::take(&mut pending.fem),
+        want_interface: coupled,
+        ..command(dt, want_snapshot, false)
+    };
+    let sph = StepCommand {
+        corrections: std::mem::take(&mut pending.sph),
+        roi,
+        want_interface: coupled,
+        ..command(dt, want_snapshot, false)
+    };
+    (fem, sph)
+}
+
+/// Fold one pass into the run's contact statistics.
+fn record(total: &mut ContactStats, pass: &PassStats, exchanged: u64, steps: u64) {
+    total.contacts += pass.contacts as u64;
+    total.max_penetration = total.max_penetration.max(pass.max_penetration);
+    total.linear_momentum_change = total.linear_momentum_change.max(pass.linear_momentum_change);
+    total.angular_momentum_change = total.angular_momentum_change.max(pass.angular_momentum_change);
+    total.exchanged_per_step = exchanged as f64 / steps.max(1) as f64;
+    total.exchanged_max = total.exchanged_max.max(pass.exchanged as u64);
 }
 
 fn snapshot<'s, T>(snap: Option<&'s T>, node: &str) -> anyhow::Result<&'s T> {
@@ -307,15 +373,15 @@ fn exchange(
     summary: &mut Summary,
     step: u64,
     t: f64,
-    cmd: StepCommand,
+    (fem_cmd, sph_cmd): (StepCommand, StepCommand),
 ) -> anyhow::Result<Round> {
     let context = || format!("coupling step {step} from t = {t} s");
     let started = Instant::now();
     if let Some(link) = nodes.sph.as_deref_mut() {
-        link.send(step, t, cmd.clone()).with_context(context)?;
+        link.send(step, t, sph_cmd).with_context(context)?;
     }
     if let Some(link) = nodes.fem.as_deref_mut() {
-        link.send(step, t, cmd).with_context(context)?;
+        link.send(step, t, fem_cmd).with_context(context)?;
     }
     let sph = match nodes.sph.as_deref_mut() {
         Some(link) => Some(link.receive(step).with_context(context)?),

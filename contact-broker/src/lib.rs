@@ -4,7 +4,9 @@
 //! adapter used by the `contact-broker` binary.
 #![warn(missing_docs)]
 
+pub mod contact;
 pub mod coordinator;
+pub mod interface;
 pub mod link;
 pub mod output;
 pub mod probes;

@@ -26,6 +26,12 @@ pub struct ContactStats {
     pub linear_momentum_change: f64,
     /// Largest relative change of total angular momentum made by any step's corrections.
     pub angular_momentum_change: f64,
+    /// Fluid particles sent to the broker per coupling step (the region of interest), on average.
+    #[serde(default)]
+    pub exchanged_per_step: f64,
+    /// Most fluid particles sent in one coupling step.
+    #[serde(default)]
+    pub exchanged_max: u64,
 }
 
 /// The run's summary.

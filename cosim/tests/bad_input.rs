@@ -325,17 +325,12 @@ fn node_with_no_broker_on_its_run_fails_within_seconds() {
 }
 
 #[test]
-fn fluid_with_solid_is_refused_by_this_build_naming_the_key() {
+fn fluid_block_overlapping_a_solid_is_refused_naming_the_key() {
     let text = GOOD.replace(
         "[[solid]]",
-        "[fluid]\ndensity = 1000.0\nspacing = 0.01\n[[fluid.block]]\nmin = [0.0, 0.02]\nmax = [0.1, 0.1]\n\n[[solid]]",
+        "[fluid]\ndensity = 1000.0\nspacing = 0.005\n[[fluid.block]]\nmin = [0.0, -0.02]\nmax = [0.1, 0.1]\n\n[[solid]]",
     );
-    assert_refused(
-        "fluid",
-        &text,
-        "solid",
-        "fluid-structure contact is not part of the run yet",
-    );
+    assert_refused("fluid", &text, "fluid.block[0]", "overlaps solid `beam`");
 }
 
 #[test]

@@ -292,6 +292,17 @@ pub enum ContactAlgorithm {
     None,
 }
 
+impl ContactAlgorithm {
+    /// The scene spelling (`particle_element` | `particle_particle` | `none`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactAlgorithm::ParticleElement => "particle_element",
+            ContactAlgorithm::ParticleParticle => "particle_particle",
+            ContactAlgorithm::None => "none",
+        }
+    }
+}
+
 /// `[contact]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -305,6 +316,13 @@ pub struct ContactSpec {
     /// Gauss–Seidel sweeps.
     #[serde(default = "default_sweeps")]
     pub sweeps: u32,
+    /// Whether the position correction also moves the structure's nodes (λ N_a / m_a, `DESIGN.md` §4.5 as
+    /// written). Off by default: the structure takes its share of the *velocity* correction (the momentum), and
+    /// its displacement follows from its own dynamics; moving FE nodes by a share of the penetration that goes
+    /// with 1/m rather than with 1/stiffness puts strain energy ½ k δ² into stiff structures that no contact
+    /// had (the hydrostatic plate inverts an element within 120 steps with it on).
+    #[serde(default)]
+    pub move_structure: bool,
 }
 
 fn default_algorithm() -> ContactAlgorithm {
@@ -321,6 +339,7 @@ impl Default for ContactSpec {
             algorithm: default_algorithm(),
             thickness: None,
             sweeps: default_sweeps(),
+            move_structure: false,
         }
     }
 }
@@ -707,7 +726,7 @@ fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
 }
 
 /// The fluid section: positive sizes, a sensible smoothing ratio, blocks that hold particles and stay out of walls.
-fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec]) -> Result<(), Invalid> {
+fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Result<(), Invalid> {
     finite_positive("fluid.density", f.density)?;
     finite_positive("fluid.spacing", f.spacing)?;
     check(
@@ -787,6 +806,18 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec]) -> Result<(), Invalid> {
                 format!("overlaps wall[{w}] (min {:?} max {:?})", wall.min, wall.max)
             })?;
         }
+        for solid in solids {
+            // The same rule against a solid's rectangle: particles inside a structure would be pushed out by
+            // the contact in the first step, with an impulse no physics asked for.
+            let overlap =
+                (0..2).all(|k| block.max[k].min(solid.max[k]) - block.min[k].max(solid.min[k]) > 0.5 * f.spacing);
+            check(!overlap, key, || {
+                format!(
+                    "overlaps solid `{}` (min {:?} max {:?})",
+                    solid.name, solid.min, solid.max
+                )
+            })?;
+        }
     }
     Ok(())
 }
@@ -833,7 +864,7 @@ impl Scene {
             || "must be at least 1".into(),
         )?;
         if let Some(fluid) = &self.fluid {
-            validate_fluid(fluid, &self.walls)?;
+            validate_fluid(fluid, &self.walls, &self.solids)?;
         }
         for (w, wall) in self.walls.iter().enumerate() {
             check(

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use cosim_proto::messages::{SphSetup, SphSnapshot, SphState, StepCommand};
+use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::Scene;
 
 use cosim_proto::scene::{FluidSolver, PpeSourceKind};
@@ -47,6 +47,14 @@ impl Fluid {
         match self {
             Fluid::Wcsph(s) => s.state(),
             Fluid::Isph(s) => s.state(),
+        }
+    }
+
+    /// Particle state, for corrections.
+    pub fn state_mut(&mut self) -> &mut FluidState {
+        match self {
+            Fluid::Wcsph(s) => s.state_mut(),
+            Fluid::Isph(s) => s.state_mut(),
         }
     }
 
@@ -117,17 +125,31 @@ impl SphCore {
         &self.solver
     }
 
-    /// Advance by `dt` (in as many stable steps as it takes) and answer. `None` for a stop.
+    /// Add the broker's position and velocity increments to the particles they name.
+    fn apply_corrections(&mut self, corrections: &[Correction]) -> Result<(), SphError> {
+        let state = self.solver.state_mut();
+        let n = state.len();
+        for c in corrections {
+            let i = c.id as usize;
+            if i >= n {
+                return Err(SphError::InvalidParameter {
+                    name: "corrections",
+                    message: format!("correction for particle {i}, but there are {n} particles"),
+                });
+            }
+            for k in 0..2 {
+                state.x[i][k] += c.dx[k];
+                state.v[i][k] += c.dv[k];
+            }
+        }
+        Ok(())
+    }
+
+    /// Apply the corrections, advance by `dt` (in as many stable steps as it takes) and answer. `None` for a stop.
     pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, SphError> {
         let started = Instant::now();
-        if !cmd.corrections.is_empty() {
-            // Contact corrections arrive with the broker's contact pass; until the fluid node applies them,
-            // refusing is better than silently dropping them.
-            return Err(SphError::InvalidParameter {
-                name: "corrections",
-                message: "this fluid node does not apply contact corrections yet".into(),
-            });
-        }
+        // DESIGN.md §3 step 5: the contact corrections of the last step, applied before this one.
+        self.apply_corrections(&cmd.corrections)?;
         if cmd.stop {
             return Ok(None);
         }

@@ -237,6 +237,12 @@ impl WcsphSolver {
         &self.state
     }
 
+    /// The particle state, for corrections applied from outside (contact, `DESIGN.md` §3 step 5). Positions and
+    /// velocities may change; the particle count and order may not.
+    pub fn state_mut(&mut self) -> &mut FluidState {
+        &mut self.state
+    }
+
     /// The wall particles.
     pub fn walls(&self) -> &WallParticles {
         &self.walls

@@ -74,10 +74,17 @@ impl FrameWriter {
     /// Point data: `displacement` (x − X), `velocity` (3 components, z = 0), `mass`. Cell data: `von_mises`
     /// ([`von_mises_2d`], the active scalar), `stress` (σxx, σyy, σxy), `solid` (index into
     /// `mesh.solid_names`).
-    pub fn write_structure(&mut self, index: usize, t: f64, mesh: &FemMesh, snap: &FemSnapshot) -> Result<PathBuf> {
+    pub fn write_structure(
+        &mut self,
+        index: usize,
+        t: f64,
+        mesh: &FemMesh,
+        snap: &FemSnapshot,
+        load: Option<&[[f64; 2]]>,
+    ) -> Result<PathBuf> {
         let name = format!("structure_{index:05}.vtu");
         let path = self.dir.join(&name);
-        let piece = structure_piece(&path, mesh, snap)?;
+        let piece = structure_piece(&path, mesh, snap, load)?;
         write_vtu(&path, piece)?;
         self.structure.push(t, &name)?;
         Ok(path)
@@ -141,7 +148,12 @@ fn vectors(name: &str, data: Vec<f64>) -> Attribute {
     })
 }
 
-fn structure_piece(path: &Path, mesh: &FemMesh, snap: &FemSnapshot) -> Result<UnstructuredGridPiece> {
+fn structure_piece(
+    path: &Path,
+    mesh: &FemMesh,
+    snap: &FemSnapshot,
+    load: Option<&[[f64; 2]]>,
+) -> Result<UnstructuredGridPiece> {
     let n = mesh.nodes.len();
     let m = mesh.cells.len();
     let check = |what: &str, len: usize, expected: usize, of: &str| {
@@ -158,6 +170,9 @@ fn structure_piece(path: &Path, mesh: &FemMesh, snap: &FemSnapshot) -> Result<Un
     check("snapshot v", snap.v.len(), n, "nodes")?;
     check("mesh masses", mesh.masses.len(), n, "nodes")?;
     check("snapshot stress", snap.stress.len(), m, "elements")?;
+    if let Some(load) = load {
+        check("interface load", load.len(), n, "nodes")?;
+    }
     check("mesh cell_solid", mesh.cell_solid.len(), m, "elements")?;
 
     let mut connectivity = Vec::with_capacity(4 * m);
@@ -192,6 +207,15 @@ fn structure_piece(path: &Path, mesh: &FemMesh, snap: &FemSnapshot) -> Result<Un
         .collect();
     let von_mises: Vec<f64> = snap.stress.iter().map(|&s| von_mises_2d(s)).collect();
     let stress: Vec<f64> = snap.stress.iter().flatten().copied().collect();
+    let mut point = vec![
+        vectors("displacement", vec3(&displacement)),
+        vectors("velocity", vec3(&snap.v)),
+        scalars("mass", 1, mesh.masses.clone()),
+    ];
+    if let Some(load) = load {
+        // DESIGN.md §4.5: the interface load is the contact impulse on each node over the coupling step [N/m].
+        point.push(vectors("interface_load", vec3(load)));
+    }
 
     Ok(UnstructuredGridPiece {
         points: vec3(&snap.x).into(),
@@ -200,11 +224,7 @@ fn structure_piece(path: &Path, mesh: &FemMesh, snap: &FemSnapshot) -> Result<Un
             types,
         },
         data: Attributes {
-            point: vec![
-                vectors("displacement", vec3(&displacement)),
-                vectors("velocity", vec3(&snap.v)),
-                scalars("mass", 1, mesh.masses.clone()),
-            ],
+            point,
             cell: vec![
                 // First scalar array is the active one ParaView colours by.
                 scalars("von_mises", 1, von_mises),
@@ -311,7 +331,7 @@ mod tests {
         let out = test_dir("vtk");
         let (mesh, snap) = two_element_mesh();
         let mut w = FrameWriter::new(&out).unwrap();
-        let path = w.write_structure(3, 0.015, &mesh, &snap).unwrap();
+        let path = w.write_structure(3, 0.015, &mesh, &snap, None).unwrap();
         assert_eq!(path, out.join("frames/structure_00003.vtu"));
 
         let piece = read_piece(&path);
@@ -353,7 +373,7 @@ mod tests {
         let mut w = FrameWriter::new(&out).unwrap();
         let times = [0.0, 0.005, 0.01];
         for (i, &t) in times.iter().enumerate() {
-            w.write_structure(i, t, &mesh, &snap).unwrap();
+            w.write_structure(i, t, &mesh, &snap, None).unwrap();
             // After every frame the collection on disk is complete and well-formed.
             let text = std::fs::read_to_string(out.join("frames/structure.pvd")).unwrap();
             let elements = parse_xml_elements(&text).unwrap();
@@ -377,7 +397,7 @@ mod tests {
         let (mesh, mut snap) = two_element_mesh();
         snap.stress.pop();
         let mut w = FrameWriter::new(&out).unwrap();
-        let e = w.write_structure(0, 0.0, &mesh, &snap).unwrap_err().to_string();
+        let e = w.write_structure(0, 0.0, &mesh, &snap, None).unwrap_err().to_string();
         assert!(e.contains("structure_00000.vtu") && e.contains("stress"), "{e}");
         assert!(w.structure_collection().entries().is_empty());
         std::fs::remove_dir_all(&out).unwrap();

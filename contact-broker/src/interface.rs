@@ -1,0 +1,300 @@
+//! The fluid–structure interface of a run (`DESIGN.md` §3 steps 1, 4): the region of interest the fluid node
+//! reports particles from, and the contact pass that turns one step's interface states into the sparse
+//! corrections both nodes apply before the next step. Pure: wire messages in, wire messages out.
+
+use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState};
+use cosim_proto::scene::{ContactAlgorithm, Scene};
+
+use crate::contact::{self, ContactWorkspace};
+
+/// What one contact pass did, for `summary.json` `contact_stats` and the frames.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PassStats {
+    /// Particles in the region of interest (exchanged this step).
+    pub exchanged: usize,
+    /// Active contacts.
+    pub contacts: usize,
+    /// Deepest penetration of the contact thickness before the correction [m].
+    pub max_penetration: f64,
+    /// |Δ Σ m v| / Σ m |Δv|: the change of total linear momentum relative to the momentum moved.
+    pub linear_momentum_change: f64,
+    /// |Δ Σ m x × v| / Σ m |x × Δv| at the corrected positions.
+    pub angular_momentum_change: f64,
+}
+
+/// The corrections of one pass, per node.
+#[derive(Clone, Debug, Default)]
+pub struct Corrections {
+    /// To the structure node (FE node ids).
+    pub fem: Vec<Correction>,
+    /// To the fluid node (particle ids).
+    pub sph: Vec<Correction>,
+}
+
+/// The interface between the structure's boundary segments and the fluid particles.
+pub struct Interface {
+    algorithm: ContactAlgorithm,
+    /// FE ids of the interface nodes, ascending (the order `fem-node` reports them in).
+    node_ids: Vec<u32>,
+    /// Segments as indices into `node_ids`.
+    segments: Vec<contact::Segment>,
+    masses: Vec<f64>,
+    fixed: Vec<bool>,
+    element: contact::ContactParams,
+    move_structure: bool,
+    all_fixed: Vec<bool>,
+    particle: contact::ParticleParticleParams,
+    /// How far outside the structure's bounding box particles are reported.
+    margin: f64,
+    workspace: ContactWorkspace,
+    /// Contact impulse of the last pass per FE node [N·s/m], for the interface load.
+    impulse: Vec<[f64; 2]>,
+    dt: f64,
+}
+
+impl Interface {
+    /// The interface of `mesh` (its boundary segments, lumped masses and clamped nodes) against `sph`'s particles.
+    pub fn new(scene: &Scene, mesh: &FemMesh, sph: &SphSetup) -> Self {
+        let mut node_ids: Vec<u32> = mesh.interface.iter().flat_map(|s| [s.a, s.b]).collect();
+        node_ids.sort_unstable();
+        node_ids.dedup();
+        let local = |id: u32| node_ids.binary_search(&id).expect("interface node");
+        let segments = mesh
+            .interface
+            .iter()
+            .map(|s| contact::Segment {
+                a: local(s.a),
+                b: local(s.b),
+            })
+            .collect();
+        let n_interface = node_ids.len();
+        let masses = node_ids.iter().map(|&id| mesh.masses[id as usize]).collect();
+        let fixed = node_ids.iter().map(|id| mesh.fixed.binary_search(id).is_ok()).collect();
+        let dx = sph.spacing;
+        let thickness = scene.contact.thickness.unwrap_or(0.5 * dx);
+        let sweeps = scene.contact.sweeps;
+        // Monaghan (1994): D ≈ 5 g H with H the deepest water, r0 = Δx (DESIGN.md §4.6).
+        let depth = scene.fluid.as_ref().map_or(0.0, |f| {
+            f.blocks.iter().map(|b| b.max[1] - b.min[1]).fold(0.0, f64::max)
+        });
+        let g = scene.run.gravity[0].hypot(scene.run.gravity[1]);
+        // Far-side limit r_c + Δx: below the thinnest structure (+ r_c) the scenes mesh, so particles on one face
+        // are never caught by the opposite face's segments.
+        let element = contact::ContactParams {
+            thickness,
+            far_side: thickness + dx,
+            sweeps,
+            ..contact::ContactParams::for_spacing(dx)
+        };
+        // Monaghan (1994) with r0 = r_c rather than Δx: the fluid's particles start Δx/2 from the structure's
+        // surface, so with r0 = Δx every one of them would start deep inside the force range (a ∝ (r0/r)^12).
+        // Boundary points at r0/2 so that no particle slips between two of them.
+        let particle = contact::ParticleParticleParams {
+            r0: thickness,
+            spacing: 0.5 * thickness,
+            ..contact::ParticleParticleParams::monaghan(dx, g, depth)
+        };
+        Self {
+            algorithm: scene.contact.algorithm,
+            node_ids,
+            segments,
+            masses,
+            fixed,
+            element,
+            move_structure: scene.contact.move_structure,
+            all_fixed: vec![true; n_interface],
+            particle,
+            // A particle moves less than h in one step (CFL), so one outside the box inflated by 2h plus the
+            // contact range cannot reach a segment before the next pass.
+            margin: 2.0 * sph.h + thickness.max(dx) + dx,
+            workspace: ContactWorkspace::default(),
+            impulse: vec![[0.0; 2]; mesh.nodes.len()],
+            dt: 0.0,
+        }
+    }
+
+    /// The FE ids of the interface nodes, in the order the structure node reports them.
+    pub fn node_ids(&self) -> &[u32] {
+        &self.node_ids
+    }
+
+    /// Whether contact is computed at all (`[contact] algorithm` not `none`).
+    pub fn active(&self) -> bool {
+        self.algorithm != ContactAlgorithm::None
+    }
+
+    /// The region of interest `[x0, y0, x1, y1]`: the bounding box of the interface nodes at `x`, inflated by
+    /// 2h + the contact range (§3 step 1).
+    pub fn roi(&self, x: &[[f64; 2]]) -> [f64; 4] {
+        let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+        for x in x {
+            b = [b[0].min(x[0]), b[1].min(x[1]), b[2].max(x[0]), b[3].max(x[1])];
+        }
+        [
+            b[0] - self.margin,
+            b[1] - self.margin,
+            b[2] + self.margin,
+            b[3] + self.margin,
+        ]
+    }
+
+    /// The contact impulse of the last pass per FE node divided by its coupling step: the interface load [N/m].
+    pub fn load(&self) -> Vec<[f64; 2]> {
+        let k = if self.dt > 0.0 { 1.0 / self.dt } else { 0.0 };
+        self.impulse.iter().map(|j| [j[0] * k, j[1] * k]).collect()
+    }
+
+    /// One contact pass (§3 step 4) on the states both nodes answered after a step of length `dt`.
+    pub fn pass(&mut self, fem: &FemState, sph: &SphState, dt: f64) -> anyhow::Result<(Corrections, PassStats)> {
+        anyhow::ensure!(
+            fem.ids == self.node_ids,
+            "fem-node reported {} interface nodes, the mesh has {}",
+            fem.ids.len(),
+            self.node_ids.len()
+        );
+        for j in &mut self.impulse {
+            *j = [0.0; 2];
+        }
+        self.dt = dt;
+        let mut stats = PassStats {
+            exchanged: sph.ids.len(),
+            ..PassStats::default()
+        };
+        if !self.active() || sph.ids.is_empty() {
+            return Ok((Corrections::default(), stats));
+        }
+        let (mut px, mut pv) = (sph.x.clone(), sph.v.clone());
+        let (mut nx, mut nv) = (fem.x.clone(), fem.v.clone());
+        let node_impulse = {
+            let particles = contact::Particles {
+                x: &mut px,
+                v: &mut pv,
+                m: &sph.m,
+            };
+            let nodes = contact::Nodes {
+                x: &mut nx,
+                v: &mut nv,
+                m: &self.masses,
+                fixed: &self.fixed,
+            };
+            match self.algorithm {
+                ContactAlgorithm::ParticleElement => {
+                    let mut report = if self.move_structure {
+                        contact::particle_element_with(
+                            &mut self.workspace,
+                            particles,
+                            nodes,
+                            &self.segments,
+                            &self.element,
+                        )?
+                    } else {
+                        // Positions against the structure held in place (its velocities are thrown away here),
+                        // then the full algorithm at the corrected positions: nothing penetrates any more, so it
+                        // only corrects the velocities of the touching pairs, with the real masses.
+                        let (mut scratch_v, mut scratch_nx, mut scratch_nv) =
+                            (particles.v.to_vec(), nodes.x.to_vec(), nodes.v.to_vec());
+                        let first = contact::particle_element_with(
+                            &mut self.workspace,
+                            contact::Particles {
+                                x: &mut *particles.x,
+                                v: &mut scratch_v,
+                                m: particles.m,
+                            },
+                            contact::Nodes {
+                                x: &mut scratch_nx,
+                                v: &mut scratch_nv,
+                                m: nodes.m,
+                                fixed: &self.all_fixed,
+                            },
+                            &self.segments,
+                            &self.element,
+                        )?;
+                        let mut second = contact::particle_element_with(
+                            &mut self.workspace,
+                            particles,
+                            nodes,
+                            &self.segments,
+                            &self.element,
+                        )?;
+                        second.contacts = first.contacts;
+                        second.max_penetration = first.max_penetration;
+                        second
+                    };
+                    stats.contacts = report.contacts;
+                    stats.max_penetration = report.max_penetration;
+                    std::mem::take(&mut report.node_impulse)
+                }
+                ContactAlgorithm::ParticleParticle => {
+                    let report = contact::particle_particle_with(
+                        &mut self.workspace,
+                        particles,
+                        nodes,
+                        &self.segments,
+                        &self.particle,
+                        dt,
+                    )?;
+                    stats.contacts = report.contacts;
+                    stats.max_penetration = report.max_penetration;
+                    report.node_impulse
+                }
+                ContactAlgorithm::None => unreachable!("checked above"),
+            }
+        };
+        tracing::debug!(
+            contacts = stats.contacts,
+            penetration = stats.max_penetration,
+            load_y = node_impulse.iter().map(|j| j[1]).sum::<f64>() / dt,
+            "contact pass"
+        );
+        for (k, j) in node_impulse.iter().enumerate() {
+            self.impulse[self.node_ids[k] as usize] = *j;
+        }
+        let (lin, ang) = momentum_change((&sph.m, &sph.v, &px, &pv), &nx, &node_impulse);
+        stats.linear_momentum_change = lin;
+        stats.angular_momentum_change = ang;
+        let corrections = Corrections {
+            fem: diff(&self.node_ids, (&fem.x, &fem.v), (&nx, &nv)),
+            sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv)),
+        };
+        Ok((corrections, stats))
+    }
+}
+
+/// Sparse (id, Δx, Δv) for every entry that changed.
+fn diff(ids: &[u32], before: (&[[f64; 2]], &[[f64; 2]]), after: (&[[f64; 2]], &[[f64; 2]])) -> Vec<Correction> {
+    let mut out = Vec::new();
+    for (k, &id) in ids.iter().enumerate() {
+        let dx = [after.0[k][0] - before.0[k][0], after.0[k][1] - before.0[k][1]];
+        let dv = [after.1[k][0] - before.1[k][0], after.1[k][1] - before.1[k][1]];
+        if dx != [0.0; 2] || dv != [0.0; 2] {
+            out.push(Correction { id, dx, dv });
+        }
+    }
+    out
+}
+
+type Side<'a> = (&'a [f64], &'a [[f64; 2]], &'a [[f64; 2]], &'a [[f64; 2]]);
+
+/// Change of total linear and angular momentum made by one pass, relative to the momentum it moved
+/// (`DESIGN.md` §5 `contact_stats`): the particles' m Δv plus the impulse every node received (m Δv for a free
+/// node, the support's reaction for a clamped one), moments taken at the corrected positions.
+fn momentum_change(fluid: Side<'_>, node_x: &[[f64; 2]], node_impulse: &[[f64; 2]]) -> (f64, f64) {
+    let (mut dp, mut dl, mut moved, mut moved_l) = ([0.0f64; 2], 0.0f64, 0.0f64, 0.0f64);
+    let mut add = |x: [f64; 2], j: [f64; 2]| {
+        dp[0] += j[0];
+        dp[1] += j[1];
+        let torque = x[0] * j[1] - x[1] * j[0];
+        dl += torque;
+        moved += j[0].hypot(j[1]);
+        moved_l += torque.abs();
+    };
+    let (m, v0, x1, v1) = fluid;
+    for i in 0..m.len() {
+        add(x1[i], [m[i] * (v1[i][0] - v0[i][0]), m[i] * (v1[i][1] - v0[i][1])]);
+    }
+    for (x, j) in node_x.iter().zip(node_impulse) {
+        add(*x, *j);
+    }
+    let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
+    (rel(dp[0].hypot(dp[1]), moved), rel(dl.abs(), moved_l))
+}
