@@ -20,6 +20,8 @@ pub enum Command {
     Run(RunArgs),
     /// Validate a scene and print what would run.
     Check(CheckArgs),
+    /// Draw one probe of several finished runs in one plot (and print its extremes per run).
+    Compare(CompareArgs),
 }
 
 /// `cosim run`.
@@ -61,4 +63,18 @@ pub struct CheckArgs {
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `cosim compare`.
+#[derive(Args, Debug, Clone)]
+pub struct CompareArgs {
+    /// Output folders of finished runs (each with a probes.csv); `LABEL=DIR` names the curve.
+    #[arg(required = true)]
+    pub runs: Vec<String>,
+    /// The probe (column of probes.csv) to draw.
+    #[arg(long)]
+    pub probe: String,
+    /// SVG file to write.
+    #[arg(long)]
+    pub out: PathBuf,
 }

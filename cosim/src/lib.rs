@@ -1,8 +1,10 @@
-//! The `cosim` command: launches a scene as processes or in one process (`run`), validates it (`check`).
+//! The `cosim` command: launches a scene as processes or in one process (`run`), validates it (`check`),
+//! overlays a probe of several runs (`compare`).
 #![warn(missing_docs)]
 
 pub mod check;
 pub mod cli;
+pub mod compare;
 pub mod in_process;
 pub mod launch;
 pub mod progress;

@@ -1,4 +1,4 @@
-//! `cosim`: run, check.
+//! `cosim`: run, check, compare.
 
 use std::process::ExitCode;
 
@@ -14,6 +14,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => cosim::run::run(&args),
         Command::Check(args) => cosim::check::check(&args),
+        Command::Compare(args) => cosim::compare::compare(&args),
     };
     match result {
         Ok(code) => code,

@@ -8,6 +8,7 @@
 //!
 //! Every error names the file it is about, so the caller can log it in one line and go on.
 
+mod compare;
 mod csv;
 mod plot;
 mod pvd;
@@ -15,6 +16,7 @@ mod vtk;
 
 use std::path::{Path, PathBuf};
 
+pub use compare::plot_compare;
 pub use csv::ProbeCsv;
 pub use plot::{plot_probe, read_reference};
 pub use pvd::PvdCollection;
