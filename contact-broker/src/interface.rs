@@ -41,8 +41,6 @@ pub struct Interface {
     masses: Vec<f64>,
     fixed: Vec<bool>,
     element: contact::ContactParams,
-    move_structure: bool,
-    all_fixed: Vec<bool>,
     particle: contact::ParticleParticleParams,
     /// How far outside the structure's bounding box particles are reported.
     margin: f64,
@@ -67,7 +65,6 @@ impl Interface {
                 b: local(s.b),
             })
             .collect();
-        let n_interface = node_ids.len();
         let masses = node_ids.iter().map(|&id| mesh.masses[id as usize]).collect();
         let fixed = node_ids.iter().map(|id| mesh.fixed.binary_search(id).is_ok()).collect();
         let dx = sph.spacing;
@@ -84,6 +81,7 @@ impl Interface {
             thickness,
             far_side: thickness + dx,
             sweeps,
+            move_masters: scene.contact.move_structure,
             ..contact::ContactParams::for_spacing(dx)
         };
         // Monaghan (1994) with r0 = r_c rather than Δx: the fluid's particles start Δx/2 from the structure's
@@ -101,8 +99,6 @@ impl Interface {
             masses,
             fixed,
             element,
-            move_structure: scene.contact.move_structure,
-            all_fixed: vec![true; n_interface],
             particle,
             // A particle moves less than h in one step (CFL), so one outside the box inflated by 2h plus the
             // contact range cannot reach a segment before the next pass.
@@ -179,47 +175,13 @@ impl Interface {
             };
             match self.algorithm {
                 ContactAlgorithm::ParticleElement => {
-                    let mut report = if self.move_structure {
-                        contact::particle_element_with(
-                            &mut self.workspace,
-                            particles,
-                            nodes,
-                            &self.segments,
-                            &self.element,
-                        )?
-                    } else {
-                        // Positions against the structure held in place (its velocities are thrown away here),
-                        // then the full algorithm at the corrected positions: nothing penetrates any more, so it
-                        // only corrects the velocities of the touching pairs, with the real masses.
-                        let (mut scratch_v, mut scratch_nx, mut scratch_nv) =
-                            (particles.v.to_vec(), nodes.x.to_vec(), nodes.v.to_vec());
-                        let first = contact::particle_element_with(
-                            &mut self.workspace,
-                            contact::Particles {
-                                x: &mut *particles.x,
-                                v: &mut scratch_v,
-                                m: particles.m,
-                            },
-                            contact::Nodes {
-                                x: &mut scratch_nx,
-                                v: &mut scratch_nv,
-                                m: nodes.m,
-                                fixed: &self.all_fixed,
-                            },
-                            &self.segments,
-                            &self.element,
-                        )?;
-                        let mut second = contact::particle_element_with(
-                            &mut self.workspace,
-                            particles,
-                            nodes,
-                            &self.segments,
-                            &self.element,
-                        )?;
-                        second.contacts = first.contacts;
-                        second.max_penetration = first.max_penetration;
-                        second
-                    };
+                    let mut report = contact::particle_element_with(
+                        &mut self.workspace,
+                        particles,
+                        nodes,
+                        &self.segments,
+                        &self.element,
+                    )?;
                     stats.contacts = report.contacts;
                     stats.max_penetration = report.max_penetration;
                     std::mem::take(&mut report.node_impulse)

@@ -30,6 +30,12 @@ pub struct ContactParams {
     /// Contacts within `tolerance · thickness` of touching after the position phase get the velocity correction
     /// (and those within 1e-12 · thickness plus 16 ulp of the coordinates, whatever the tolerance).
     pub tolerance: f64,
+    /// Whether the position phase moves the master nodes too (x_a −= λ N_a/m_a n, `DESIGN.md` §4.5 as written).
+    /// When false the masters are held in place for the position phase (the particle alone is projected, exactly,
+    /// as against a rigid structure) and take their share of the velocity phase only: momentum is exchanged the
+    /// same way, and no FE node is displaced by a share of the penetration that goes with 1/m instead of with the
+    /// structure's stiffness.
+    pub move_masters: bool,
 }
 
 impl Default for ContactParams {
@@ -40,13 +46,15 @@ impl Default for ContactParams {
 }
 
 impl ContactParams {
-    /// The defaults for particle spacing `dx`: r_c = Δx/2, d_max = 2Δx, 3 sweeps, tolerance 1e-9.
+    /// The defaults for particle spacing `dx`: r_c = Δx/2, d_max = 2Δx, 3 sweeps, tolerance 1e-9, masters moved
+    /// by the position phase (the paper's algorithm).
     pub fn for_spacing(dx: f64) -> Self {
         ContactParams {
             thickness: 0.5 * dx,
             far_side: 2.0 * dx,
             sweeps: 3,
             tolerance: 1e-9,
+            move_masters: true,
         }
     }
 
@@ -185,6 +193,14 @@ pub fn particle_element_with(
     };
 
     // ---- Position phase: Gauss–Seidel sweeps (DESIGN.md §4.5 "Position"). ----
+    // Masters held in place (`move_masters` off) are immovable here: the exact rigid projection below.
+    let held;
+    let pos_fixed: &[bool] = if params.move_masters {
+        fixed
+    } else {
+        held = vec![true; nn];
+        &held
+    };
     for sweep in 0..params.sweeps {
         let mut worst = 0.0f64;
         #[allow(clippy::needless_range_loop)] // s indexes x, m and touched together
@@ -196,7 +212,7 @@ pub fn particle_element_with(
             rigid.clear();
             let im_s = 1.0 / particles.m[s];
             for &m in masters.iter() {
-                if ctx.detector(nodes.x).is_rigid(m, fixed) {
+                if ctx.detector(nodes.x).is_rigid(m, pos_fixed) {
                     rigid.push(m);
                     continue;
                 }
@@ -216,7 +232,7 @@ pub fn particle_element_with(
                 // x_s += (λ/m_s) n; x1 −= (λ N1/m1) n; x2 −= (λ N2/m2) n.
                 particles.x[s] = axpy(particles.x[s], lam * im_s, h.n);
                 for (k, nk) in [(h.a, h.na), (h.b, h.nb)] {
-                    if !fixed[k] && nk != 0.0 {
+                    if !pos_fixed[k] && nk != 0.0 {
                         nodes.x[k] = axpy(nodes.x[k], -lam * nk * inv_m[k], h.n);
                     }
                     report.node_position_impulse[k] = axpy(report.node_position_impulse[k], -lam * nk, h.n);
@@ -455,6 +471,7 @@ mod tests {
             far_side: 0.2,
             sweeps: 1,
             tolerance: 0.0,
+            move_masters: true,
         };
         let p = Particles {
             x: &mut px,
