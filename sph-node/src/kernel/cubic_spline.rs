@@ -60,6 +60,63 @@ impl CubicSpline {
         dw_dq / self.h
     }
 
+    /// (W(r), dW/dr(r)/r) in one evaluation, bit for bit as [`CubicSpline::w`] and [`CubicSpline::dw_dr`]`(r) / r`
+    /// (the factor is 0 at r = 0, where [`CubicSpline::grad`] is zero): ∇_i W_ij = factor · r_ij.
+    #[inline]
+    pub fn w_and_grad_factor(&self, r: f64) -> (f64, f64) {
+        let q = r / self.h;
+        let (w, dw_dq) = if q < 1.0 {
+            (
+                self.alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q),
+                self.alpha * (-3.0 * q + 2.25 * q * q),
+            )
+        } else if q < 2.0 {
+            let t = 2.0 - q;
+            (self.alpha * 0.25 * t * t * t, -0.75 * self.alpha * t * t)
+        } else {
+            (0.0, 0.0)
+        };
+        let factor = if r > 0.0 { dw_dq / self.h / r } else { 0.0 };
+        (w, factor)
+    }
+
+    /// For squared distances `d2` (each below the support squared): r² = r · r with r = √d2 (as
+    /// [`crate::particles::separation`] gives r), the ∇W factor ([`CubicSpline::w_and_grad_factor`]) and W, bit for
+    /// bit as the scalar functions. Branch-free, so that the compiler can evaluate several pairs at once.
+    pub fn pair_values(&self, d2: &[f64], r2: &mut [f64], grad: &mut [f64], w: &mut [f64]) {
+        let (h, alpha) = (self.h, self.alpha);
+        for (((&d2, r2), g), w) in d2.iter().zip(r2).zip(grad).zip(w) {
+            let r = d2.sqrt();
+            let q = r / h;
+            let t = 2.0 - q;
+            let (w_near, dq_near) = (
+                alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q),
+                alpha * (-3.0 * q + 2.25 * q * q),
+            );
+            let (w_far, dq_far) = (alpha * 0.25 * t * t * t, -0.75 * alpha * t * t);
+            let near = q < 1.0;
+            let inside = q < 2.0;
+            let wv = if near {
+                w_near
+            } else if inside {
+                w_far
+            } else {
+                0.0
+            };
+            let dq = if near {
+                dq_near
+            } else if inside {
+                dq_far
+            } else {
+                0.0
+            };
+            let f = dq / h / r;
+            *g = if r > 0.0 { f } else { 0.0 };
+            *w = wv;
+            *r2 = r * r;
+        }
+    }
+
     /// ∇_i W_ij for r_ij = x_i − x_j at distance `r` = |r_ij|; zero at r = 0.
     #[inline]
     pub fn grad(&self, r_ij: [f64; 2], r: f64) -> [f64; 2] {
@@ -82,5 +139,31 @@ mod tests {
         let above = k.w(1.0 + 1e-12);
         assert!((below - above).abs() < 1e-10);
         assert_eq!(k.w(2.0), 0.0);
+    }
+
+    #[test]
+    fn fused_evaluation_is_bitwise_equal() {
+        let k = CubicSpline::new(0.0013);
+        for i in 0..=3000 {
+            let r = i as f64 * 0.0026 / 2900.0;
+            let (w, f) = k.w_and_grad_factor(r);
+            assert_eq!(w.to_bits(), k.w(r).to_bits(), "W at r = {r}");
+            let g = k.grad([r, 0.0], r);
+            assert_eq!((f * r).to_bits(), g[0].to_bits(), "grad at r = {r}");
+            if r > 0.0 {
+                assert_eq!(f.to_bits(), (k.dw_dr(r) / r).to_bits(), "factor at r = {r}");
+            }
+            let d2 = [r * r];
+            let (mut r2, mut g, mut wv) = ([0.0], [0.0], [0.0]);
+            k.pair_values(&d2, &mut r2, &mut g, &mut wv);
+            let rr = d2[0].sqrt();
+            assert_eq!(r2[0].to_bits(), (rr * rr).to_bits());
+            assert_eq!(wv[0].to_bits(), k.w(rr).to_bits(), "W at r = {rr}");
+            assert_eq!(
+                g[0].to_bits(),
+                k.w_and_grad_factor(rr).1.to_bits(),
+                "factor at r = {rr}"
+            );
+        }
     }
 }

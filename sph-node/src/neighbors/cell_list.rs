@@ -124,42 +124,176 @@ impl CellList {
 
     /// Neighbour lists (self excluded) of the first `n_query` particles of `positions`, built in parallel.
     pub fn neighbor_list(&self, positions: &[[f64; 2]], n_query: usize, radius: f64) -> NeighborList {
-        let lists: Vec<Vec<u32>> = (0..n_query)
-            .into_par_iter()
-            .map(|i| {
-                let mut out = Vec::with_capacity(32);
-                self.gather_into(positions, positions[i], Some(i), radius, &mut out);
-                out
-            })
-            .collect();
-        let mut start = Vec::with_capacity(n_query + 1);
-        start.push(0);
-        let mut idx = Vec::with_capacity(lists.iter().map(Vec::len).sum());
-        for l in &lists {
-            idx.extend_from_slice(l);
-            start.push(idx.len());
-        }
-        NeighborList { start, idx }
+        let mut list = NeighborList::default();
+        list.build(n_query, |i, chunk| {
+            self.gather_into(positions, positions[i], Some(i), radius, &mut chunk.idx)
+        });
+        list
     }
 }
 
-/// Compressed per-particle neighbour lists (self excluded), each in the fixed gather order.
+/// Particles per chunk of a [`NeighborList`] (a power of two): the unit of parallel work and of storage.
+pub const CHUNK: usize = 256;
+
+/// The neighbour lists of [`CHUNK`] consecutive particles, stored together, with optional kernel factors per pair.
+#[derive(Clone, Debug, Default)]
+pub struct ListChunk {
+    /// First particle of the chunk.
+    first: usize,
+    /// `start[k]..start[k + 1]` indexes the pair arrays for particle `first + k`.
+    start: Vec<u32>,
+    /// Neighbour indices.
+    pub idx: Vec<u32>,
+    /// ∇W factor per pair (see [`ListChunk::grad`]); longer than `idx` when it held more pairs before.
+    grad: Vec<f64>,
+    /// r² per pair (see [`ListChunk::r2`]); as `grad`.
+    r2: Vec<f64>,
+    /// W per pair (see [`ListChunk::w`]); as `grad`.
+    w: Vec<f64>,
+    /// The builder evaluated the kernel ([`ListChunk::kernel_values`]) since the chunk was cleared.
+    kernel_written: bool,
+    /// Candidate indices of the particle being gathered (builder scratch).
+    pub(super) cand_idx: Vec<u32>,
+    /// Candidate squared distances (builder scratch).
+    pub(super) cand_d2: Vec<f64>,
+}
+
+impl ListChunk {
+    /// First particle of the chunk.
+    #[inline]
+    pub fn first(&self) -> usize {
+        self.first
+    }
+
+    /// Number of particles in the chunk.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    /// True when the chunk holds no particle.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Pair index range of the chunk's `k`-th particle.
+    #[inline]
+    pub fn range(&self, k: usize) -> std::ops::Range<usize> {
+        self.start[k] as usize..self.start[k + 1] as usize
+    }
+
+    /// Neighbours of the chunk's `k`-th particle.
+    #[inline]
+    pub fn of(&self, k: usize) -> &[u32] {
+        &self.idx[self.range(k)]
+    }
+
+    fn clear(&mut self, first: usize) {
+        self.first = first;
+        self.kernel_written = false;
+        self.start.clear();
+        self.start.push(0);
+        self.idx.clear();
+        // The kernel values keep their length, to be overwritten in place ([`ListChunk::kernel_values`]) and cut
+        // to the pair count at the end of the chunk.
+    }
+
+    /// The ∇W factor of every pair, dW/dr(r)/r (∇_i W_ij = factor · r_ij), when the builder evaluated the kernel
+    /// (else empty); indexed as `idx`.
+    #[inline]
+    pub fn grad(&self) -> &[f64] {
+        &self.grad[..self.kernel_len()]
+    }
+
+    /// r² of every pair (r · r, r = |r_ij| as [`crate::particles::separation`] computes it), as [`ListChunk::grad`].
+    #[inline]
+    pub fn r2(&self) -> &[f64] {
+        &self.r2[..self.kernel_len()]
+    }
+
+    /// W(r) of every pair, as [`ListChunk::grad`].
+    #[inline]
+    pub fn w(&self) -> &[f64] {
+        &self.w[..self.kernel_len()]
+    }
+
+    fn kernel_len(&self) -> usize {
+        if self.kernel_written {
+            self.idx.len()
+        } else {
+            0
+        }
+    }
+
+    /// (∇W factor, r², W) slices for the pairs `start..start + n`, for a builder that evaluates the kernel to fill
+    /// (the storage is reused from list to list without being zeroed first).
+    #[inline]
+    pub fn kernel_values(&mut self, start: usize, n: usize) -> (&mut [f64], &mut [f64], &mut [f64]) {
+        let end = start + n;
+        self.kernel_written = true;
+        if self.r2.len() < end {
+            let len = end + end / 32;
+            self.grad.resize(len, 0.0);
+            self.r2.resize(len, 0.0);
+            self.w.resize(len, 0.0);
+        }
+        (
+            &mut self.grad[start..end],
+            &mut self.r2[start..end],
+            &mut self.w[start..end],
+        )
+    }
+
+    fn close_particle(&mut self) {
+        self.start.push(self.idx.len() as u32);
+    }
+}
+
+/// Per-particle neighbour lists (self excluded), each in the fixed gather order, stored in chunks of [`CHUNK`]
+/// particles that are built in parallel and never concatenated.
 #[derive(Clone, Debug, Default)]
 pub struct NeighborList {
-    start: Vec<usize>,
-    idx: Vec<u32>,
+    n: usize,
+    chunks: Vec<ListChunk>,
 }
 
 impl NeighborList {
+    /// Rebuilds the lists of particles `0..n`, reusing the allocations: `gather(i, chunk)` appends the neighbours
+    /// of particle i to `chunk.idx` (and, if it evaluates the kernel, fills their values through
+    /// [`ListChunk::kernel_values`], for every particle of the chunk). Chunks are filled in parallel; the lists do not depend on the thread count.
+    pub fn build<F>(&mut self, n: usize, gather: F)
+    where
+        F: Fn(usize, &mut ListChunk) + Sync,
+    {
+        self.n = n;
+        let n_chunks = n.div_ceil(CHUNK);
+        self.chunks.truncate(n_chunks);
+        self.chunks.resize_with(n_chunks, ListChunk::default);
+        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+            let first = c * CHUNK;
+            chunk.clear(first);
+            for i in first..(first + CHUNK).min(n) {
+                gather(i, chunk);
+                chunk.close_particle();
+            }
+        });
+    }
+
     /// Neighbours of particle i.
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {
-        &self.idx[self.start[i]..self.start[i + 1]]
+        self.chunks[i / CHUNK].of(i % CHUNK)
+    }
+
+    /// The chunks, in particle order.
+    pub fn chunks(&self) -> &[ListChunk] {
+        &self.chunks
     }
 
     /// Number of particles with a list.
     pub fn len(&self) -> usize {
-        self.start.len().saturating_sub(1)
+        self.n
     }
 
     /// True when no particle has a list.
@@ -169,6 +303,17 @@ impl NeighborList {
 
     /// Total number of (ordered) pairs.
     pub fn pair_count(&self) -> usize {
-        self.idx.len()
+        self.chunks.iter().map(|c| c.idx.len()).sum()
+    }
+
+    /// Bytes held by the lists (capacity).
+    pub fn heap_bytes(&self) -> usize {
+        self.chunks
+            .iter()
+            .map(|c| {
+                4 * (c.start.capacity() + c.idx.capacity() + c.cand_idx.capacity())
+                    + 8 * (c.grad.capacity() + c.r2.capacity() + c.w.capacity() + c.cand_d2.capacity())
+            })
+            .sum()
     }
 }

@@ -1,0 +1,296 @@
+//! Cell-sorted particle order for the WCSPH solver: the fluid particles are kept sorted by cell (then by id) in
+//! memory, so that the particles of one cell, and of the cells of one grid row, are contiguous; wall particles
+//! do not move, so they keep their order and are binned by cell once (again only when the grid changes).
+//!
+//! The grid is the one [`super::CellList`] builds over all particles (fluid and walls): cell size = kernel
+//! support, origin at the lower corner of the bounding box. A gather visits the 3 × 3 block of cells row by row
+//! (bottom to top), cells left to right, and inside a cell the fluid particles by id, then the wall particles by
+//! index, which is exactly the order of [`super::CellList::gather_into`] on the combined fluid-then-wall array:
+//! every sum runs over the same neighbours in the same order, so the results do not depend on the memory order
+//! (nor on the thread count).
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+use super::cell_list::{ListChunk, NeighborList};
+use crate::kernel::CubicSpline;
+
+/// A uniform grid over a bounding box.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Grid {
+    origin: [f64; 2],
+    cell_size: f64,
+    dims: [usize; 2],
+}
+
+impl Grid {
+    /// Cells of size `cell_size` covering the box `lo`–`hi` (as [`super::CellList`] bins).
+    pub fn covering(lo: [f64; 2], hi: [f64; 2], cell_size: f64) -> Self {
+        Self {
+            origin: lo,
+            cell_size,
+            dims: [0, 1].map(|k| ((hi[k] - lo[k]) / cell_size).floor() as usize + 1),
+        }
+    }
+
+    /// Number of cells.
+    pub fn n_cells(&self) -> usize {
+        self.dims[0] * self.dims[1]
+    }
+
+    /// Cell coordinates of `p` (clamped to the grid).
+    #[inline]
+    pub fn coords(&self, p: [f64; 2]) -> [usize; 2] {
+        [0, 1].map(|k| {
+            let c = ((p[k] - self.origin[k]) / self.cell_size).floor();
+            (c.max(0.0) as usize).min(self.dims[k] - 1)
+        })
+    }
+
+    /// Cell index of `p` (row-major, x fastest).
+    #[inline]
+    pub fn cell_of(&self, p: [f64; 2]) -> usize {
+        let [cx, cy] = self.coords(p);
+        cy * self.dims[0] + cx
+    }
+
+    /// The 3 × 3 block around cell `c`: rows `y0..=y1`, columns `x0..=x1` (clipped at the grid's edges).
+    #[inline]
+    fn block(&self, c: usize) -> ([usize; 2], [usize; 2]) {
+        let (cx, cy) = (c % self.dims[0], c / self.dims[0]);
+        (
+            [cy.saturating_sub(1), (cy + 1).min(self.dims[1] - 1)],
+            [cx.saturating_sub(1), (cx + 1).min(self.dims[0] - 1)],
+        )
+    }
+}
+
+/// Lower and upper corners of the bounding box of `x` (`None` when empty).
+fn bounds(x: &[[f64; 2]]) -> Option<([f64; 2], [f64; 2])> {
+    x.par_iter().with_min_len(4096).map(|p| (*p, *p)).reduce_with(|a, b| {
+        (
+            [a.0[0].min(b.0[0]), a.0[1].min(b.0[1])],
+            [a.1[0].max(b.1[0]), a.1[1].max(b.1[1])],
+        )
+    })
+}
+
+/// Fluid sorted by cell, walls binned by cell, on the grid of the current positions.
+#[derive(Clone, Debug, Default)]
+pub struct SortedCells {
+    grid: Grid,
+    /// `fluid_start[c]..fluid_start[c + 1]`: the (sorted) fluid indices in cell c.
+    fluid_start: Vec<u32>,
+    /// Cell of each fluid particle, in sorted order.
+    fluid_cell: Vec<u32>,
+    /// Bounding box of the walls (fixed).
+    wall_bounds: Option<([f64; 2], [f64; 2])>,
+    /// The grid the walls are binned on.
+    wall_grid: Option<Grid>,
+    /// `wall_start[c]..wall_start[c + 1]` indexes `wall_sorted` for cell c.
+    wall_start: Vec<u32>,
+    /// Wall numbers sorted by cell, then number.
+    wall_sorted: Vec<u32>,
+    /// Cell of each wall particle.
+    wall_cell: Vec<u32>,
+    /// Cells of the fluid in the previous order (scratch).
+    old_cell: Vec<u32>,
+    /// Fill pointers of the counting sort (scratch).
+    next: Vec<u32>,
+}
+
+impl SortedCells {
+    /// For the fixed wall particles `wall_x`.
+    pub fn new(wall_x: &[[f64; 2]]) -> Self {
+        Self {
+            wall_bounds: bounds(wall_x),
+            ..Self::default()
+        }
+    }
+
+    /// Bytes held (capacities).
+    pub fn heap_bytes(&self) -> usize {
+        4 * [
+            &self.fluid_start,
+            &self.fluid_cell,
+            &self.wall_start,
+            &self.wall_sorted,
+            &self.wall_cell,
+            &self.old_cell,
+            &self.next,
+        ]
+        .iter()
+        .map(|v| v.capacity())
+        .sum::<usize>()
+    }
+
+    /// The grid of the last [`SortedCells::sort`].
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// Re-sorts the fluid for its positions `x` (in the current memory order) on the grid of cell size
+    /// `cell_size` over fluid and walls. `ids` maps memory slots to particle ids and `slot` ids to slots; both are
+    /// updated to the new order, which is by cell, then id. `src[n]` receives the old slot of the particle that
+    /// goes to slot n (the caller moves its arrays accordingly).
+    pub fn sort(
+        &mut self,
+        x: &[[f64; 2]],
+        wall_x: &[[f64; 2]],
+        cell_size: f64,
+        ids: &mut [u32],
+        slot: &mut [u32],
+        src: &mut Vec<u32>,
+    ) {
+        let nf = x.len();
+        let (lo, hi) = match (bounds(x), self.wall_bounds) {
+            (Some(f), Some(w)) => (
+                [f.0[0].min(w.0[0]), f.0[1].min(w.0[1])],
+                [f.1[0].max(w.1[0]), f.1[1].max(w.1[1])],
+            ),
+            (Some(b), None) | (None, Some(b)) => b,
+            (None, None) => ([0.0; 2], [0.0; 2]),
+        };
+        self.grid = Grid::covering(lo, hi, cell_size);
+        let grid = self.grid;
+        let n_cells = grid.n_cells();
+        if self.wall_grid != Some(grid) {
+            self.bin_walls(wall_x);
+        }
+        // Counting sort by cell, visiting the particles by id: stable in id.
+        self.old_cell.clear();
+        x.par_iter()
+            .with_min_len(4096)
+            .map(|&p| grid.cell_of(p) as u32)
+            .collect_into_vec(&mut self.old_cell);
+        self.fluid_start.clear();
+        self.fluid_start.resize(n_cells + 1, 0);
+        for &c in &self.old_cell {
+            self.fluid_start[c as usize + 1] += 1;
+        }
+        for c in 0..n_cells {
+            self.fluid_start[c + 1] += self.fluid_start[c];
+        }
+        self.next.clear();
+        self.next.extend_from_slice(&self.fluid_start[..n_cells]);
+        // Every entry of these is overwritten below.
+        src.resize(nf, 0);
+        self.fluid_cell.resize(nf, 0);
+        for (id, s) in slot.iter_mut().enumerate() {
+            let old = *s as usize;
+            let c = self.old_cell[old];
+            let n = self.next[c as usize];
+            self.next[c as usize] += 1;
+            src[n as usize] = old as u32;
+            ids[n as usize] = id as u32;
+            self.fluid_cell[n as usize] = c;
+            *s = n;
+        }
+    }
+
+    fn bin_walls(&mut self, wall_x: &[[f64; 2]]) {
+        let grid = self.grid;
+        let n_cells = grid.n_cells();
+        self.wall_cell.clear();
+        self.wall_cell.extend(wall_x.iter().map(|&p| grid.cell_of(p) as u32));
+        self.wall_start.clear();
+        self.wall_start.resize(n_cells + 1, 0);
+        for &c in &self.wall_cell {
+            self.wall_start[c as usize + 1] += 1;
+        }
+        for c in 0..n_cells {
+            self.wall_start[c + 1] += self.wall_start[c];
+        }
+        self.next.clear();
+        self.next.extend_from_slice(&self.wall_start[..n_cells]);
+        self.wall_sorted.clear();
+        self.wall_sorted.resize(wall_x.len(), 0);
+        for (w, &c) in self.wall_cell.iter().enumerate() {
+            let n = &mut self.next[c as usize];
+            self.wall_sorted[*n as usize] = w as u32;
+            *n += 1;
+        }
+        self.wall_grid = Some(grid);
+    }
+
+    /// Neighbour lists (self excluded) of the fluid particles `0..n_fluid` of `x` (sorted fluid first, then the
+    /// walls), each with the kernel values of its pairs ([`ListChunk::grad`], [`ListChunk::r2`], [`ListChunk::w`]);
+    /// neighbours are the particles closer than `kernel.support()`, in the order of the module documentation.
+    pub fn build_fluid_lists(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, list: &mut NeighborList) {
+        list.build(n_fluid, |i, chunk| self.gather_fluid(x, n_fluid, kernel, i, chunk));
+    }
+
+    /// Appends the neighbours of fluid slot i, with their kernel values, to `chunk`.
+    #[inline]
+    fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {
+        let radius = kernel.support();
+        let r2max = radius * radius;
+        let d0 = self.grid.dims[0];
+        let xi = x[i];
+        let ([y0, y1], [x0, x1]) = self.grid.block(self.fluid_cell[i] as usize);
+        // Candidates of the block, in gather order.
+        let mut total = 0;
+        for y in y0..=y1 {
+            let row = y * d0;
+            total += (self.fluid_start[row + x1 + 1] - self.fluid_start[row + x0]) as usize;
+            total += (self.wall_start[row + x1 + 1] - self.wall_start[row + x0]) as usize;
+        }
+        if chunk.cand_idx.len() < total {
+            chunk.cand_idx.resize(total, 0);
+            chunk.cand_d2.resize(total, 0.0);
+        }
+        // Branch-free compaction: every candidate is written, the count advances only for a neighbour.
+        let mut n = 0;
+        let (cand_idx, cand_d2) = (&mut chunk.cand_idx, &mut chunk.cand_d2);
+        let mut visit = |j: usize| {
+            let p = x[j];
+            let dx = xi[0] - p[0];
+            let dy = xi[1] - p[1];
+            let d2 = dx * dx + dy * dy;
+            cand_idx[n] = j as u32;
+            cand_d2[n] = d2;
+            n += usize::from((d2 < r2max) & (j != i));
+        };
+        for y in y0..=y1 {
+            let row = y * d0;
+            if self.wall_start[row + x0] == self.wall_start[row + x1 + 1] {
+                // No walls in this row of the block: its fluid is one contiguous range.
+                for j in self.fluid_start[row + x0]..self.fluid_start[row + x1 + 1] {
+                    visit(j as usize);
+                }
+                continue;
+            }
+            for c in row + x0..=row + x1 {
+                for j in self.fluid_start[c]..self.fluid_start[c + 1] {
+                    visit(j as usize);
+                }
+                for &w in &self.wall_sorted[self.wall_start[c] as usize..self.wall_start[c + 1] as usize] {
+                    visit(n_fluid + w as usize);
+                }
+            }
+        }
+        let start = chunk.idx.len();
+        chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
+        // r as `separation` computes it; W and the ∇W factor as `CubicSpline::w` and `::grad`.
+        let d2 = std::mem::take(&mut chunk.cand_d2);
+        let (grad, r2, w) = chunk.kernel_values(start, n);
+        kernel.pair_values(&d2[..n], r2, grad, w);
+        chunk.cand_d2 = d2;
+    }
+
+    /// The sorted fluid slots in the 3 × 3 block of cells around wall particle `w`, one range per row (empty
+    /// ranges where the block is clipped), in gather order.
+    #[inline]
+    pub fn fluid_near_wall(&self, w: usize) -> [Range<usize>; 3] {
+        let d0 = self.grid.dims[0];
+        let ([y0, y1], [x0, x1]) = self.grid.block(self.wall_cell[w] as usize);
+        let row = |y: usize| {
+            if y > y1 {
+                return 0..0;
+            }
+            self.fluid_start[y * d0 + x0] as usize..self.fluid_start[y * d0 + x1 + 1] as usize
+        };
+        [row(y0), row(y0 + 1), row(y0 + 2)]
+    }
+}
