@@ -14,6 +14,16 @@
 //! Hydrodynamic quantities: no Taylor correction of v or ρ; instead the density is changed as the continuity
 //! equation would change it for the displacement δr ([`shift_density_change`]), keeping ρ consistent with the
 //! particle number density.
+//!
+//! Still water (why the scene default of β is 0; numbers in `docs/CORRECTIONS.md`): the WCSPH square lattice
+//! pairs up under hydrostatic load with or without APD (cubic spline, h = 1.3Δx, α = 0.01). With the v_max Δt
+//! scale the shift is about 100 times weaker in still water (v_max of a few cm/s) than in a dam break and does
+//! not stop the pairing; once pairs exist it pushes the partners apart every step while the pressure holds them
+//! together, and that exchange feeds the noise (β = 0.04: 8 % r.m.s. particle pressure noise mid-depth, six
+//! times the kinetic energy of β = 0, unstable before t = 9 s). A shift strong enough to keep the lattice
+//! ordered (a velocity scale of sqrt(g H)) does stop the pairing, but the shift moves particles without
+//! changing their velocity, so wherever its fixed point and the pressure balance differ (walls, corners) the
+//! particles keep a velocity equal to the shift rate, which grows until the run blows up (≈ 5 s).
 
 use rayon::prelude::*;
 

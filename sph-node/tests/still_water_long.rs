@@ -1,0 +1,222 @@
+//! Still water on a coarse grid over 10 s of physical time, WCSPH and ISPH (case 7.1 of
+//! /work/shared/data/07_sph_analytic, run five times longer than `still_water.rs` and `isph_still_water.rs`, at
+//! 12 × 20 fluid particles): the tank must stay quiet for the whole run, not only after the first settling.
+//!
+//! Criteria (each solver at its scene defaults):
+//! - no fluid particle enters a wall: at every step every fluid particle stays at least [`WALL_GAP`]·Δx inside
+//!   the faces of the tank (x = 0, x = W, y = 0). Particles start Δx/2 from a face and the first layer of wall
+//!   particles sits Δx/2 behind it, so a particle closer than Δx/4 to a face is within 3Δx/4 of a wall
+//!   particle: pushed into the wall's support, which the walls of §4.7 exist to prevent;
+//! - the kinetic energy stays below a bound, a fraction of the column's potential energy ρ0 g W H²/2 (the bounds
+//!   and the measured values are stated at the assertions);
+//! - at the end, the pressure at y = 0.1, 0.2 and 0.3 m on the centre line follows p = ρ0 g (H − y) within 2 %,
+//!   averaged over the last [`T_AVERAGE`] s (an ISPH pressure changes by a few % from one step to the next).
+//!
+//! The grid keeps H/Δx and W/Δx whole numbers: a block that is not a whole number of spacings holds fewer rows
+//! than its height, and the settled level (and with it the pressure) is lower than the scene's H.
+
+mod common;
+
+use sph_node::{IsphSolver, WcsphSolver};
+
+/// Fluid depth H [m].
+const DEPTH: f64 = 0.5;
+/// Tank width W [m].
+const WIDTH: f64 = 0.3;
+/// Spacing Δx [m]: 12 × 20 fluid particles.
+const DX: f64 = 0.025;
+/// Physical time simulated [s].
+const T_END: f64 = 10.0;
+/// The pressure is averaged over t ∈ [T_END − T_AVERAGE, T_END].
+const T_AVERAGE: f64 = 0.5;
+const DEPTHS: [f64; 3] = [0.1, 0.2, 0.3];
+/// Smallest allowed distance of a fluid particle from a tank face, in units of Δx.
+const WALL_GAP: f64 = 0.25;
+const RHO0: f64 = 1000.0;
+const G: f64 = 9.81;
+
+/// What the test needs of a fluid solver.
+trait Tank {
+    /// One step at the solver's stable Δt; the new time.
+    fn advance(&mut self) -> f64;
+    fn positions(&self) -> &[[f64; 2]];
+    fn kinetic_energy(&self) -> f64;
+    fn pressure_at(&self, point: [f64; 2]) -> f64;
+    fn steps(&self) -> u64;
+}
+
+impl Tank for WcsphSolver {
+    fn advance(&mut self) -> f64 {
+        let dt = self.stable_dt();
+        self.step(dt).expect("stable");
+        self.state().t
+    }
+    fn positions(&self) -> &[[f64; 2]] {
+        &self.state().x
+    }
+    fn kinetic_energy(&self) -> f64 {
+        WcsphSolver::kinetic_energy(self)
+    }
+    fn pressure_at(&self, point: [f64; 2]) -> f64 {
+        self.sample_pressure(point).expect("fluid there")
+    }
+    fn steps(&self) -> u64 {
+        self.state().step
+    }
+}
+
+impl Tank for IsphSolver {
+    fn advance(&mut self) -> f64 {
+        let dt = self.stable_dt();
+        self.step(dt).expect("stable and converged");
+        self.state().t
+    }
+    fn positions(&self) -> &[[f64; 2]] {
+        &self.state().x
+    }
+    fn kinetic_energy(&self) -> f64 {
+        IsphSolver::kinetic_energy(self)
+    }
+    fn pressure_at(&self, point: [f64; 2]) -> f64 {
+        self.sample_pressure(point).expect("fluid there")
+    }
+    fn steps(&self) -> u64 {
+        self.state().step
+    }
+}
+
+/// What one run measured.
+struct Record {
+    /// Largest kinetic energy over the run, over the second half of the run, in units of [`e_pot`].
+    ke_max: f64,
+    ke_max_late: f64,
+    /// Smallest distance of any fluid particle from a tank face over the run, in units of Δx, and when.
+    gap_min: f64,
+    t_gap_min: f64,
+    /// Relative pressure error at each of `DEPTHS`, mean over the last `T_AVERAGE` s against ρ0 g (H − y).
+    p_err: [f64; 3],
+}
+
+/// Potential energy scale of the column, ρ0 g W H²/2 [J/m].
+fn e_pot() -> f64 {
+    RHO0 * G * WIDTH * DEPTH * DEPTH / 2.0
+}
+
+/// Smallest distance of the particles from the tank faces x = 0, x = W and y = 0, in units of Δx.
+fn wall_gap(x: &[[f64; 2]]) -> f64 {
+    x.iter()
+        .map(|p| p[0].min(WIDTH - p[0]).min(p[1]) / DX)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Runs `tank` to `T_END`, measuring as it goes, and prints what it measured.
+fn run(name: &str, tank: &mut impl Tank) -> Record {
+    let (mut ke_max, mut ke_max_late) = (0.0_f64, 0.0_f64);
+    let (mut gap_min, mut t_gap_min) = (f64::INFINITY, 0.0);
+    let (mut p_sum, mut n_avg) = ([0.0; 3], 0usize);
+    let mut t = 0.0;
+    while t < T_END {
+        t = tank.advance();
+        let k = tank.kinetic_energy() / e_pot();
+        ke_max = ke_max.max(k);
+        if t >= 0.5 * T_END {
+            ke_max_late = ke_max_late.max(k);
+        }
+        let gap = wall_gap(tank.positions());
+        if gap < gap_min {
+            (gap_min, t_gap_min) = (gap, t);
+        }
+        if t >= T_END - T_AVERAGE {
+            for (s, y) in p_sum.iter_mut().zip(DEPTHS) {
+                *s += tank.pressure_at([0.5 * WIDTH, y]);
+            }
+            n_avg += 1;
+        }
+    }
+    let p_err = [0, 1, 2].map(|k| {
+        let exact = RHO0 * G * (DEPTH - DEPTHS[k]);
+        (p_sum[k] / n_avg as f64 - exact) / exact
+    });
+    eprintln!(
+        "{name}: {} fluid particles, {} steps to t = {T_END} s; max KE {ke_max:.2e} E_pot (over t ≥ {} s: \
+         {ke_max_late:.2e} E_pot; E_pot = {:.1} J/m); closest approach to a tank face {gap_min:.3} Δx at t = \
+         {t_gap_min:.2} s; pressure error over the last {T_AVERAGE} s at y = {DEPTHS:?}: {:+.3} %, {:+.3} %, \
+         {:+.3} %",
+        tank.positions().len(),
+        tank.steps(),
+        0.5 * T_END,
+        e_pot(),
+        100.0 * p_err[0],
+        100.0 * p_err[1],
+        100.0 * p_err[2]
+    );
+    Record {
+        ke_max,
+        ke_max_late,
+        gap_min,
+        t_gap_min,
+        p_err,
+    }
+}
+
+fn assert_pressure(name: &str, r: &Record) {
+    for (e, y) in r.p_err.iter().zip(DEPTHS) {
+        assert!(e.abs() < 0.02, "{name}: pressure error {:.3} % at y = {y}", 100.0 * e);
+    }
+}
+
+fn assert_no_wall_entry(name: &str, r: &Record) {
+    assert!(
+        r.gap_min >= WALL_GAP,
+        "{name}: a fluid particle came within {:.3} Δx of a tank face at t = {:.2} s (allowed {WALL_GAP} Δx)",
+        r.gap_min,
+        r.t_gap_min
+    );
+}
+
+fn isph() -> IsphSolver {
+    IsphSolver::new(&common::still_water(WIDTH, DEPTH, DX, "solver = \"isph\"")).expect("solver")
+}
+
+/// WCSPH (scene defaults: Shepard every 20 steps, XSPH 0.5, the scene's APD β).
+#[test]
+fn wcsph_still_water_stays_still_for_10_s() {
+    let mut solver = WcsphSolver::new(&common::still_water(WIDTH, DEPTH, DX, "")).expect("solver");
+    let r = run("WCSPH", &mut solver);
+    assert_no_wall_entry("WCSPH", &r);
+    // Bounds: 2e-4 E_pot over the run, an r.m.s. speed of 1.4 % of sqrt(g H) (the settling transient of the
+    // first 2 s; measured 5.4e-5), and 5e-5 E_pot over the second half, which catches a slow growth (measured
+    // 7.9e-6). A run that pumps energy in, as WCSPH with APD β = 0.04 did, ends far above both.
+    assert!(r.ke_max < 2e-4, "WCSPH: max KE {:.3e} E_pot", r.ke_max);
+    assert!(
+        r.ke_max_late < 5e-5,
+        "WCSPH: max KE over t ≥ 5 s {:.3e} E_pot",
+        r.ke_max_late
+    );
+    // Measured: −0.97 %, −0.03 %, −1.07 %, the water level a little low after the particles rearrange.
+    assert_pressure("WCSPH", &r);
+}
+
+/// ISPH (scene defaults: divergence-free source, XSPH 0.5, no particle shifting): energy and pressure. The wall
+/// criterion is `isph_no_particle_enters_a_wall_in_10_s`, which fails today.
+#[test]
+fn isph_still_water_stays_still_for_10_s() {
+    let r = run("ISPH", &mut isph());
+    // Bound: 1e-2 E_pot, an r.m.s. speed of 10 % of sqrt(g H). Measured 3.0e-3 (and 4.4e-3 with the ISPH wall
+    // guard being added to `isph/`); the ISPH kinetic energy wanders between 1e-3 and 3e-3 E_pot from t = 1 s on
+    // without growing, and `isph_still_water.rs` bounds the first 2 s by 2.5e-3.
+    assert!(r.ke_max < 1e-2, "ISPH: max KE {:.3e} E_pot", r.ke_max);
+    // Measured: +0.57 %, +0.84 %, +0.78 % (+0.48 %, +0.63 %, +0.79 % with the wall guard).
+    assert_pressure("ISPH", &r);
+}
+
+/// ISPH against the wall criterion. Fails today: the free-surface particles where the surface meets a side
+/// wall climb into that wall (the first crosses the face x = 0 at y = 0.478 m, t = 0.29 s) and go in and out of
+/// it for the rest of the run (deepest −0.65 Δx, at t = 4.2 s; with the ISPH wall guard being added to `isph/`,
+/// which puts such particles back on the face, still −0.02 Δx at t = 5.4 s). Run with `--ignored` to see it.
+#[test]
+#[ignore = "known failure: ISPH free-surface particles at the side walls enter the walls (down to -0.65 dx)"]
+fn isph_no_particle_enters_a_wall_in_10_s() {
+    let r = run("ISPH", &mut isph());
+    assert_no_wall_entry("ISPH", &r);
+}
