@@ -53,9 +53,7 @@ pub struct Interface {
 impl Interface {
     /// The interface of `mesh` (its boundary segments, lumped masses and clamped nodes) against `sph`'s particles.
     pub fn new(scene: &Scene, mesh: &FemMesh, sph: &SphSetup) -> Self {
-        let mut node_ids: Vec<u32> = mesh.interface.iter().flat_map(|s| [s.a, s.b]).collect();
-        node_ids.sort_unstable();
-        node_ids.dedup();
+        let node_ids = mesh.interface_nodes();
         let local = |id: u32| node_ids.binary_search(&id).expect("interface node");
         let segments = mesh
             .interface

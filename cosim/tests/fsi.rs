@@ -44,16 +44,7 @@ fn run(name: &str, scene: &str, sets: &[&str], processes: bool) -> std::path::Pa
 
 /// (t, value) of probe `name` from `DIR/probes.csv`.
 fn series(out: &Path, name: &str) -> Vec<(f64, f64)> {
-    let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header.iter().position(|h| *h == name).expect("probe column");
-    lines
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|v| v.parse().unwrap()).collect();
-            (v[0], v[k])
-        })
-        .collect()
+    cosim::compare::read_probe(out, name).expect("probe column")
 }
 
 /// Mean of the samples with t in (a, b].

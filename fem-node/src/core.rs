@@ -23,9 +23,7 @@ impl FemCore {
         let model = FemModel::build(scene)?;
         let solver = FemSolver::new(model, scene.coupling.fem_cfl)?;
         let mesh = solver.mesh_message();
-        let mut interface_nodes: Vec<u32> = mesh.interface.iter().flat_map(|s| [s.a, s.b]).collect();
-        interface_nodes.sort_unstable();
-        interface_nodes.dedup();
+        let interface_nodes = mesh.interface_nodes();
         Ok(Self {
             solver,
             mesh,

@@ -37,6 +37,16 @@ pub struct FemMesh {
     pub dt_stable: f64,
 }
 
+impl FemMesh {
+    /// Ids of the nodes on the interface segments, ascending and unique: the order `fem/state` reports them in.
+    pub fn interface_nodes(&self) -> Vec<u32> {
+        let mut ids: Vec<u32> = self.interface.iter().flat_map(|s| [s.a, s.b]).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+}
+
 /// A sparse correction to one particle or node: position and velocity increments.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Correction {
