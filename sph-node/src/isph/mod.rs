@@ -5,6 +5,9 @@
 //! * [`projection`]: the per-particle gathers of the predictor, the PPE source and the corrector.
 //! * [`ppe`]: the pressure Poisson equation assembled as sparse rows from the neighbour lists.
 //! * [`bicgstab`]: BiCGSTAB with Jacobi preconditioning and fixed-order (thread-count independent) reductions.
+//! * [`contact`]: the particles against a structure the fluid does not see (coupled runs): Neumann rows, not a free
+//!   surface.
+//! * [`wall_guard`]: a particle found inside a wall is put back on its face.
 //! * [`solver`]: [`IsphSolver`], with the public API of [`crate::WcsphSolver`].
 //!
 //! Walls are PPE unknowns: each wall particle has the row of the Adami et al. 2012 extrapolation, Eq. (27),
@@ -14,10 +17,12 @@
 //! After the solve negative pressures are clipped to 0 (fluid and walls).
 
 pub mod bicgstab;
+pub mod contact;
 pub mod free_surface;
 pub mod ppe;
 pub mod projection;
 pub mod solver;
+pub mod wall_guard;
 
 pub use solver::IsphSolver;
 

@@ -69,6 +69,14 @@ impl SparseRows {
             .collect()
     }
 
+    /// Replaces row i by the Dirichlet row p_i = 0 in place (the diagonal becomes 1, the other entries 0; the
+    /// caller sets the right-hand side to 0).
+    pub fn set_dirichlet(&mut self, i: usize) {
+        for k in self.start[i]..self.start[i + 1] {
+            self.val[k] = if self.col[k] as usize == i { 1.0 } else { 0.0 };
+        }
+    }
+
     /// y = A x (a gather per row).
     pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
         y.par_iter_mut().enumerate().for_each(|(i, yi)| {
@@ -76,6 +84,86 @@ impl SparseRows {
             *yi = c.iter().zip(v).map(|(&c, &v)| v * x[c as usize]).sum();
         });
     }
+}
+
+/// Makes the system nonsingular: every unknown must reach a Dirichlet row (p = 0: a free-surface particle, or a
+/// wall particle with no fluid in reach) through the nonzero entries of its row. A group of rows that does not
+/// (a fluid particle pushed inside a wall, whose only neighbours are wall particles that extrapolate from it alone;
+/// a pocket of fluid cut off from every free surface) is a pure Neumann problem: singular, and with an inconsistent
+/// right-hand side BiCGSTAB diverges. The highest fluid particle (largest −g · x, then the lowest index) of each
+/// such group is given p = 0: its row becomes Dirichlet, `b` and `free` are set accordingly.
+///
+/// Returns the particles anchored this way (in the order they were anchored). Sequential and in index order, so
+/// the result does not depend on the thread count.
+pub fn anchor_floating_groups(
+    a: &mut SparseRows,
+    b: &mut [f64],
+    free: &mut [bool],
+    x: &[[f64; 2]],
+    n_fluid: usize,
+    gravity: [f64; 2],
+) -> Vec<usize> {
+    let n = a.n();
+    // Transposed graph of the off-diagonal nonzeros: who points at j.
+    let mut count = vec![0u32; n + 1];
+    let mut dirichlet = vec![true; n];
+    for (i, d) in dirichlet.iter_mut().enumerate() {
+        let (c, v) = a.row(i);
+        for (&j, &vij) in c.iter().zip(v) {
+            if j as usize != i && vij != 0.0 {
+                count[j as usize + 1] += 1;
+                *d = false;
+            }
+        }
+    }
+    for k in 0..n {
+        count[k + 1] += count[k];
+    }
+    let mut fill = count.clone();
+    let mut from = vec![0u32; count[n] as usize];
+    for i in 0..n {
+        let (c, v) = a.row(i);
+        for (&j, &vij) in c.iter().zip(v) {
+            if j as usize != i && vij != 0.0 {
+                from[fill[j as usize] as usize] = i as u32;
+                fill[j as usize] += 1;
+            }
+        }
+    }
+    // Anchored: reaches a Dirichlet row. Breadth-first from the Dirichlet rows along the reversed edges.
+    let mut anchored = dirichlet;
+    let mut queue: Vec<u32> = (0..n as u32).filter(|&i| anchored[i as usize]).collect();
+    let spread = |queue: &mut Vec<u32>, anchored: &mut Vec<bool>| {
+        while let Some(j) = queue.pop() {
+            for &i in &from[count[j as usize] as usize..count[j as usize + 1] as usize] {
+                if !anchored[i as usize] {
+                    anchored[i as usize] = true;
+                    queue.push(i);
+                }
+            }
+        }
+    };
+    spread(&mut queue, &mut anchored);
+    let mut floating: Vec<usize> = (0..n_fluid).filter(|&i| !anchored[i]).collect();
+    if floating.is_empty() {
+        return floating;
+    }
+    let height = |i: usize| -(gravity[0] * x[i][0] + gravity[1] * x[i][1]);
+    floating.sort_by(|&i, &j| height(j).total_cmp(&height(i)).then(i.cmp(&j)));
+    let mut pinned = Vec::new();
+    for i in floating {
+        if anchored[i] {
+            continue;
+        }
+        a.set_dirichlet(i);
+        b[i] = 0.0;
+        free[i] = true;
+        anchored[i] = true;
+        pinned.push(i);
+        queue.push(i as u32);
+        spread(&mut queue, &mut anchored);
+    }
+    pinned
 }
 
 /// Coefficient c_ij ≥ 0 of pair ij in an interior row (Shao & Lo 2003, Eq. (15), sign flipped).
@@ -89,6 +177,12 @@ pub fn laplacian_coefficient(m_j: f64, rho_i: f64, rho_j: f64, r: f64, kernel: &
 }
 
 /// Row of fluid particle i and its right-hand side, given `source_i` and the free-surface flag.
+///
+/// `hydrostatic = Some((g, ρ0))` for a particle in contact with a structure the fluid does not see (its support is
+/// cut by the structure, [`super::contact`]): the row is written for p − ρ0 g · x,
+/// Σ_j c_ij [(p_i − p_j) − ρ0 g · (x_i − x_j)] = −source_i, so that the missing side carries the Neumann condition
+/// ∂p/∂n = ρ0 g · n (the hydrostatic field solves the truncated row exactly; on a full support the added term is
+/// the SPH Laplacian of a linear field, ≈ 0). Without it the cut row reads ∂p/∂n = 0 at the structure.
 pub fn fluid_row(
     i: usize,
     view: &ParticleView<'_>,
@@ -96,6 +190,7 @@ pub fn fluid_row(
     kernel: &CubicSpline,
     free_surface: bool,
     source: f64,
+    hydrostatic: Option<([f64; 2], f64)>,
 ) -> (Vec<(u32, f64)>, f64) {
     if free_surface {
         // §4.3 step 3: Dirichlet p = 0 on the free surface
@@ -105,14 +200,18 @@ pub fn fluid_row(
     let mut row = Vec::with_capacity(neighbors.len() + 1);
     row.push((i as u32, 0.0));
     let mut diag = 0.0;
+    let mut rhs = -source;
     for &j in neighbors {
-        let (_, r) = separation(xi, view.x[j as usize]);
+        let (r_ij, r) = separation(xi, view.x[j as usize]);
         let c = laplacian_coefficient(view.m[j as usize], rho_i, view.rho[j as usize], r, kernel);
         diag += c;
         row.push((j, -c));
+        if let Some((g, rho0)) = hydrostatic {
+            rhs += c * rho0 * (g[0] * r_ij[0] + g[1] * r_ij[1]);
+        }
     }
     row[0].1 = diag;
-    (row, -source)
+    (row, rhs)
 }
 
 /// Row of wall particle w (a `view` index ≥ `n_fluid`) and its right-hand side: Adami et al. 2012, Eq. (27).
@@ -150,21 +249,25 @@ pub fn wall_row(
     (row, rhs)
 }
 
-/// Assembles the whole system: `sources` (one per fluid particle) and `free` (free-surface flags) in, the
-/// matrix and right-hand side out.
+/// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags) and `contact`
+/// (particles against a structure, see [`fluid_row`]; empty for none) in, the matrix and right-hand side out.
+#[allow(clippy::too_many_arguments)]
 pub fn assemble(
     view: &ParticleView<'_>,
     list: &NeighborList,
     kernel: &CubicSpline,
     gravity: [f64; 2],
+    rho0: f64,
     free: &[bool],
+    contact: &[bool],
     sources: &[f64],
 ) -> (SparseRows, Vec<f64>) {
     let rows: Vec<(Vec<(u32, f64)>, f64)> = (0..view.x.len())
         .into_par_iter()
         .map(|i| {
             if i < view.n_fluid {
-                fluid_row(i, view, list.of(i), kernel, free[i], sources[i])
+                let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
+                fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic)
             } else {
                 wall_row(i, view, list.of(i), kernel, gravity)
             }
@@ -173,4 +276,41 @@ pub fn assemble(
     let b = rows.iter().map(|r| r.1).collect();
     let rows: Vec<Vec<(u32, f64)>> = rows.into_iter().map(|r| r.0).collect();
     (SparseRows::from_rows(&rows), b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_group_without_a_dirichlet_row_is_anchored_at_its_highest_particle() {
+        // 0: free surface; 1–2: fluid connected to it; 3–4: fluid connected only through wall 5 (a particle pushed
+        // into a wall): a pure Neumann group.
+        let rows: Vec<Vec<(u32, f64)>> = vec![
+            vec![(0, 1.0)],
+            vec![(1, 2.0), (0, -1.0), (2, -1.0)],
+            vec![(2, 1.0), (1, -1.0)],
+            vec![(3, 1.0), (5, -1.0)],
+            vec![(4, 1.0), (5, -1.0)],
+            vec![(5, 1.0), (3, -0.5), (4, -0.5)],
+        ];
+        let mut a = SparseRows::from_rows(&rows);
+        let mut b = vec![0.0, 1.0, 1.0, 1.0, 1.0, 0.5];
+        let mut free = vec![true, false, false, false, false];
+        let x = [
+            [0.0, 0.5],
+            [0.0, 0.4],
+            [0.0, 0.3],
+            [0.0, -0.01],
+            [0.0, -0.005],
+            [0.0, -0.01],
+        ];
+        let pinned = anchor_floating_groups(&mut a, &mut b, &mut free, &x, 5, [0.0, -9.81]);
+        assert_eq!(pinned, vec![4]);
+        assert!(free[4] && !free[3]);
+        assert_eq!(b[4], 0.0);
+        assert_eq!(a.row(4).1, &[1.0, 0.0]);
+        // Anchored groups are left alone.
+        assert!(anchor_floating_groups(&mut a, &mut b, &mut free, &x, 5, [0.0, -9.81]).is_empty());
+    }
 }

@@ -2,6 +2,8 @@
 //! walls as PPE unknowns (Adami et al. 2012, Eq. (27) rows; §4.7) and optional XSPH (§4.4).
 //!
 //! One step of size Δt:
+//! 0. in a coupled run, the contact's corrections since the last step tell which particles lean on a structure
+//!    ([`super::contact`]), and a particle found inside a wall is put back on its face ([`super::wall_guard`]);
 //! 1. predictor u* = uⁿ + Δt (g + ν∇²uⁿ), x* = xⁿ + Δt u*;
 //! 2. neighbours at x*; free surface (∇·r < 1.5 → p = 0); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
 //! 3. PPE solved by Jacobi-BiCGSTAB warm-started from the last pressures (fluid and walls);
@@ -12,6 +14,8 @@
 use cosim_proto::scene::{BoxSpec, FluidSolver, Scene};
 use rayon::prelude::*;
 
+use super::contact::{self, ContactLayer, ContactRow};
+use super::wall_guard::WallBoxes;
 use super::{bicgstab, free_surface, ppe, projection, IsphOptions, PpeSource};
 use crate::boundary::walls;
 use crate::corrections::xsph;
@@ -34,6 +38,8 @@ struct Scratch {
     cells: CellList,
     list: NeighborList,
     free: Vec<bool>,
+    contact: Vec<Option<ContactRow>>,
+    in_contact: Vec<bool>,
     source: Vec<f64>,
     xsph: Vec<[f64; 2]>,
 }
@@ -47,6 +53,14 @@ pub struct PpeReport {
     pub residual: f64,
     /// Fluid particles given p = 0 as free surface.
     pub free_surface: usize,
+    /// Fluid particles whose support a structure face cuts (the first layer against it and the second row; see
+    /// [`super::contact`]).
+    pub contact: usize,
+    /// Fluid particles given p = 0 because their group of PPE rows reached no Dirichlet row
+    /// ([`ppe::anchor_floating_groups`]).
+    pub anchored: usize,
+    /// Fluid particles found inside a wall at the start of the step and put back on its face.
+    pub wall_pushes: usize,
 }
 
 /// Incompressible SPH solver (projection method).
@@ -66,6 +80,11 @@ pub struct IsphSolver {
     /// source (the cubic spline sum of a lattice is not exactly 1).
     rho_ref: f64,
     last_ppe: PpeReport,
+    /// The particles the contact corrected lately and the faces they revealed (coupled runs; see
+    /// [`super::contact`]).
+    contact: ContactLayer,
+    /// The wall boxes, to put back a particle found inside a wall (see [`super::wall_guard`]).
+    wall_boxes: WallBoxes,
     scratch: Scratch,
 }
 
@@ -126,6 +145,7 @@ impl IsphSolver {
             [s[0] / n, s[1] / n]
         };
         let wall_x = walls::wall_positions(&scene.walls, spec.blocks[0].min, dx, h, fluid_centre);
+        let wall_boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
         let nw = wall_x.len();
         let walls = WallParticles {
             x: wall_x,
@@ -133,8 +153,20 @@ impl IsphSolver {
             rho: vec![rho0; nw],
             m: vec![rho0 * dx * dx; nw],
         };
-        // Domain: as WcsphSolver, the box around blocks and walls padded by half its largest extent.
-        let pad = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 4.0 * h;
+        // Domain: as WcsphSolver, the box around blocks and walls padded by half its largest extent, and at least by
+        // how far a particle that leaves the walls can travel in the run: the end of a floor it flows off, a jet
+        // thrown up by an impact on a structure. ISPH fronts and jets move at the fluid's full speed (the elastic
+        // gate's front runs at 2.1 m/s, ≈ 2 sqrt(g H), and falls off the floor's end at x = 0.5 m at t = 0.24 s;
+        // the obstacle throws a particle up at 4 m/s), so the padding is 2 sqrt(2 |g| H) T + |g| T²/2 for a run of
+        // T = end_time. This box only catches runaway particles; it bounds no search grid.
+        let g_abs = gravity[0].hypot(gravity[1]);
+        let v_fluid = {
+            let (top, bottom) = setup::fluid_extent(spec);
+            (2.0 * g_abs * (top - bottom)).sqrt()
+        };
+        let t_end = scene.run.end_time.max(0.0);
+        let reach = 2.0 * v_fluid * t_end + 0.5 * g_abs * t_end * t_end;
+        let pad = (0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 4.0 * h).max(reach);
         let domain = BoxSpec {
             min: [lo[0] - pad, lo[1] - pad],
             max: [hi[0] + pad, hi[1] + pad],
@@ -169,14 +201,14 @@ impl IsphSolver {
             state,
             walls,
             a_max: gravity[0].hypot(gravity[1]),
-            v_ref: {
-                let (top, bottom) = setup::fluid_extent(spec);
-                (2.0 * gravity[0].hypot(gravity[1]) * (top - bottom)).sqrt()
-            },
+            v_ref: v_fluid,
             rho_ref,
             last_ppe: PpeReport::default(),
+            contact: ContactLayer::default(),
+            wall_boxes,
             scratch: Scratch::default(),
         };
+        solver.contact.record_end(&solver.state);
         solver.scratch.m = solver.state.m.iter().chain(&solver.walls.m).copied().collect();
         solver.scratch.rho = vec![rho0; solver.state.len() + nw];
         solver.scratch.v = vec![[0.0; 2]; solver.state.len() + nw];
@@ -281,6 +313,15 @@ impl IsphSolver {
         let step_no = self.state.step + 1;
         let nf = self.state.len();
         let g = self.params.gravity;
+        // The solver's own step for this state: the density terms of the source relax over it (see below).
+        let dt_own = self.stable_dt();
+        // 0. Contact corrections applied since the last step (coupled runs): which particles lean on a structure,
+        //    and particles put inside a wall sent back to its face.
+        self.contact.detect(&self.state, self.params.dx);
+        let mut wall_pushes = 0;
+        for (x, v) in self.state.x.iter_mut().zip(self.state.v.iter_mut()) {
+            wall_pushes += usize::from(self.wall_boxes.push_out(x, v));
+        }
         let x_n = self.state.x.clone();
         let v_n = self.state.v.clone();
 
@@ -318,16 +359,57 @@ impl IsphSolver {
             self.options.free_surface_threshold,
             &mut free,
         );
+        // Particles against a structure (see `super::contact`): their support, ∇·r and ρ* count the structure's
+        // half-space; their rows carry the face's Neumann condition.
+        let mut rows = std::mem::take(&mut self.scratch.contact);
+        contact::contact_rows_into(
+            &self.view(),
+            &self.scratch.list,
+            &self.kernel,
+            &self.contact,
+            self.params.dx,
+            self.params.rho0,
+            self.options.free_surface_threshold,
+            &mut free,
+            &mut rows,
+        );
+        let mut in_contact = std::mem::take(&mut self.scratch.in_contact);
+        in_contact.clear();
+        in_contact.extend(rows.iter().map(Option::is_some));
+        let n_contact = in_contact.iter().filter(|&&c| c).count();
         let mut source = std::mem::take(&mut self.scratch.source);
         source.clear();
-        // Walls carry Δt g for the divergence only (see `projection::velocity_divergence`).
+        // Walls carry Δt g for the divergence only (see `projection::velocity_divergence`), and so does the normal
+        // velocity of the first layer against a structure, with the face's (see `contact::face_normal_velocity`).
         for v in &mut self.scratch.v[nf..] {
             *v = [dt * g[0], dt * g[1]];
+        }
+        for (v, row) in self.scratch.v[..nf].iter_mut().zip(&rows) {
+            if let Some(row) = row.filter(|r| r.against) {
+                *v = contact::face_normal_velocity(*v, &row.face, dt, g);
+            }
         }
         {
             let view = self.view();
             let (list, kernel) = (&self.scratch.list, &self.kernel);
             let (rho0, rho_ref) = (self.params.rho0, self.rho_ref);
+            // Δt² of the density terms: Δt · max(Δt, Δt_own). They move a particle by a fixed fraction of its density
+            // error per step (Δx ∝ Δt² · source), so a step shorter than the solver's own (a coupled run steps at
+            // the coupling's max_dt, 1e-4 s where ISPH would take 1e-3 s) would relax the density that many times
+            // faster in time, and the ~1 % deficit the summation reads next to any truncated support (the second
+            // row under a free surface or over a structure) would become a sink of −γ 0.01 ρ0 Δx²/(4 Δt²) ≈ −3 kPa
+            // at 2e-4 s: a suction that, clipped, takes the hydrostatic pressure off the structure. At Δt = Δt_own
+            // (every uncoupled run) this is Δt², bit for bit.
+            let dt2 = dt * dt.max(dt_own);
+            // ρ* of a particle against a structure counts the structure's half-space as fluid.
+            let rows = &rows;
+            let rho_star = |i: usize| {
+                let s = match rows[i] {
+                    Some(row) => row.density,
+                    None => projection::summation_density(i, &view, list.of(i), kernel),
+                };
+                s * rho0 / rho_ref
+            };
             match self.options.source {
                 // Cummins & Rudman 1999, Eq. (15): ∇·(∇p/ρ) = ∇·u*/Δt
                 // + Asai et al. 2012, Eq. (25): γ (ρ0 − ρ*)/(ρ0 Δt²) when density_relaxation γ > 0
@@ -338,9 +420,7 @@ impl IsphSolver {
                         .map(|i| {
                             let div = projection::velocity_divergence(i, &view, list.of(i), kernel) / dt;
                             if gamma > 0.0 {
-                                let rho_star =
-                                    projection::summation_density(i, &view, list.of(i), kernel) * rho0 / rho_ref;
-                                div + gamma * (rho0 - rho_star) / (rho0 * dt * dt)
+                                div + gamma * (rho0 - rho_star(i)) / (rho0 * dt2)
                             } else {
                                 div
                             }
@@ -351,10 +431,7 @@ impl IsphSolver {
                 // full-lattice sum (ρ* = ρ0 on the initial lattice)
                 PpeSource::DensityInvariant => (0..nf)
                     .into_par_iter()
-                    .map(|i| {
-                        let rho_star = projection::summation_density(i, &view, list.of(i), kernel) * rho0 / rho_ref;
-                        (rho0 - rho_star) / (rho0 * dt * dt)
-                    })
+                    .map(|i| (rho0 - rho_star(i)) / (rho0 * dt2))
                     .collect_into_vec(&mut source),
             }
         }
@@ -363,7 +440,17 @@ impl IsphSolver {
             *v = [0.0, 0.0];
         }
         // 3. PPE (Shao & Lo 2003, Eq. (15); walls: Adami et al. 2012, Eq. (27)), warm-started.
-        let (a, b) = ppe::assemble(&self.view(), &self.scratch.list, &self.kernel, g, &free, &source);
+        let (mut a, mut b) = ppe::assemble(
+            &self.view(),
+            &self.scratch.list,
+            &self.kernel,
+            g,
+            self.params.rho0,
+            &free,
+            &in_contact,
+            &source,
+        );
+        let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
         let inv_diag: Vec<f64> = a
             .diagonal()
             .iter()
@@ -386,6 +473,8 @@ impl IsphSolver {
         let n_free = free.iter().filter(|&&f| f).count();
         self.scratch.free = free;
         self.scratch.source = source;
+        self.scratch.contact = rows;
+        self.scratch.in_contact = in_contact;
         let stats = match result {
             Ok(s) => s,
             Err(s) => {
@@ -400,6 +489,9 @@ impl IsphSolver {
             iterations: stats.iterations,
             residual: stats.residual,
             free_surface: n_free,
+            contact: n_contact,
+            anchored: pinned.len(),
+            wall_pushes,
         };
         if let Some(i) = p.iter().position(|p| !p.is_finite()) {
             return Err(self.unstable(step_no, i.min(nf.saturating_sub(1)), "non-finite PPE pressure".into()));
@@ -459,6 +551,7 @@ impl IsphSolver {
         self.rebuild_neighbors();
         self.state.t += dt;
         self.state.step = step_no;
+        self.contact.record_end(&self.state);
         Ok(())
     }
 

@@ -1,0 +1,141 @@
+//! Fluid particles found inside a rigid wall are put back on its face (coupled runs).
+//!
+//! The PPE cannot hold a fluid particle inside a wall: its neighbours are wall particles only, whose rows
+//! (Adami et al. 2012, Eq. (27)) extrapolate from that particle alone, so the group has no Dirichlet row and is
+//! singular, and nothing pushes the particle out (the wall pressures extrapolated from it carry only the hydrostatic
+//! term ρ g Δx, less than its weight): it sinks through the wall and leaves the domain. In a coupled run the
+//! broker's contact puts particles there: a structure face that lies on a wall (the lower face of the elastic
+//! obstacle, clamped to the floor; the gate's tip, resting on the floor when the run starts) pushes the particles
+//! that pass next to it by up to r_c + the penetration into the floor (`DESIGN.md` §4.5: the contact does not
+//! know the SPH walls).
+//!
+//! Each wall box (grown as the wall particles fill it, [`crate::boundary::walls::wall_positions`]) is a rigid
+//! obstacle: a fluid particle strictly inside one is moved to the nearest face through which it leaves every box, and
+//! the part of its velocity into that face is removed (a perfectly plastic normal impact, as the particle–element
+//! contact does). Particles outside the walls are never touched, so a run without contact is unchanged unless a
+//! particle enters a wall.
+
+use cosim_proto::scene::BoxSpec;
+
+use crate::boundary::walls::layers_needed;
+
+/// The wall boxes of a scene.
+#[derive(Clone, Debug, Default)]
+pub struct WallBoxes {
+    boxes: Vec<([f64; 2], [f64; 2])>,
+    /// A particle put back goes this far out of the face (a millionth of Δx), so that it is outside every box.
+    margin: f64,
+}
+
+impl WallBoxes {
+    /// The boxes of `walls`, each grown away from the fluid to the layers its particles fill (as
+    /// [`crate::boundary::walls::wall_positions`] does for a box thinner than the kernel support).
+    pub fn new(walls: &[BoxSpec], dx: f64, h: f64, fluid_centre: [f64; 2]) -> Self {
+        let layers = layers_needed(dx, h) as f64;
+        let boxes = walls
+            .iter()
+            .map(|w| {
+                let (mut lo, mut hi) = (w.min, w.max);
+                for k in 0..2 {
+                    let need = layers * dx - (hi[k] - lo[k]);
+                    if need > 1e-12 {
+                        if 0.5 * (lo[k] + hi[k]) < fluid_centre[k] {
+                            lo[k] -= need;
+                        } else {
+                            hi[k] += need;
+                        }
+                    }
+                }
+                (lo, hi)
+            })
+            .collect();
+        Self {
+            boxes,
+            margin: 1e-6 * dx,
+        }
+    }
+
+    /// Whether `x` is strictly inside a box.
+    fn inside(&self, x: [f64; 2]) -> bool {
+        self.boxes
+            .iter()
+            .any(|(lo, hi)| (0..2).all(|k| x[k] > lo[k] && x[k] < hi[k]))
+    }
+
+    /// Moves a particle strictly inside a wall box to the nearest point outside every box whose coordinates are
+    /// its own or those of box faces (just outside them: a face, or a corner where boxes meet), and removes the
+    /// part of its velocity into the wall along each coordinate that changed. Returns whether it was moved.
+    pub fn push_out(&self, x: &mut [f64; 2], v: &mut [f64; 2]) -> bool {
+        if !self.inside(*x) {
+            return false;
+        }
+        let d = self.margin;
+        let coords =
+            |k: usize| std::iter::once(x[k]).chain(self.boxes.iter().flat_map(move |(lo, hi)| [lo[k] - d, hi[k] + d]));
+        let mut best: Option<(f64, [f64; 2])> = None;
+        for cx in coords(0) {
+            for cy in coords(1) {
+                let y = [cx, cy];
+                let dist = (cx - x[0]).hypot(cy - x[1]);
+                if best.is_none_or(|(b, _)| dist < b) && !self.inside(y) {
+                    best = Some((dist, y));
+                }
+            }
+        }
+        let Some((_, y)) = best else {
+            return false; // cannot happen: the corner beyond every box is outside them all
+        };
+        for k in 0..2 {
+            let out = y[k] - x[k];
+            if out != 0.0 && v[k] * out < 0.0 {
+                v[k] = 0.0;
+            }
+        }
+        *x = y;
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tank() -> WallBoxes {
+        let b = |min, max| BoxSpec { min, max };
+        WallBoxes::new(
+            &[b([-0.012, -0.012], [0.5, 0.0]), b([-0.012, 0.0], [0.0, 0.3])],
+            0.004,
+            0.0052,
+            [0.1, 0.1],
+        )
+    }
+
+    #[test]
+    fn particles_outside_are_untouched() {
+        let w = tank();
+        for p in [[0.1, 0.002], [0.001, 0.1], [0.0, 0.0], [0.2, 0.0]] {
+            let (mut x, mut v) = (p, [1.0, -1.0]);
+            assert!(!w.push_out(&mut x, &mut v));
+            assert_eq!((x, v), (p, [1.0, -1.0]));
+        }
+    }
+
+    #[test]
+    fn a_particle_in_the_floor_goes_back_up() {
+        let w = tank();
+        let (mut x, mut v) = ([0.2, -0.002], [2.0, -0.5]);
+        assert!(w.push_out(&mut x, &mut v));
+        assert!((x[0] - 0.2).abs() < 1e-15 && x[1] > 0.0 && x[1] < 1e-8, "{x:?}");
+        assert_eq!(v, [2.0, 0.0]);
+    }
+
+    #[test]
+    fn a_particle_in_the_corner_leaves_both_walls() {
+        let w = tank();
+        let (mut x, mut v) = ([-0.001, -0.0015], [-1.0, -1.0]);
+        assert!(w.push_out(&mut x, &mut v));
+        assert!(!w.inside(x), "{x:?}");
+        assert!(x[0] > 0.0 && x[1] > 0.0 && x[0] < 1e-8 && x[1] < 1e-8, "{x:?}");
+        assert_eq!(v, [0.0, 0.0]);
+    }
+}
