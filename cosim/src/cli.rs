@@ -50,6 +50,40 @@ pub struct RunArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Start every node but this one and wait for an outside program that speaks `docs/PROTOCOL.md` to join in
+    /// its place; the run id and the endpoint to give it are printed and written to `DIR/external.json`.
+    #[arg(long, value_enum, value_name = "NODE")]
+    pub external: Option<ExternalNode>,
+    /// Seconds to wait for the external node to register (with `--external`).
+    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
+    pub wait_external: f64,
+}
+
+/// A node an outside program can take the place of.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExternalNode {
+    /// The structure node (`fem-node`).
+    Fem,
+    /// The fluid node (`sph-node`).
+    Sph,
+}
+
+impl ExternalNode {
+    /// The program it stands in for.
+    pub fn program(self) -> &'static str {
+        match self {
+            Self::Fem => "fem-node",
+            Self::Sph => "sph-node",
+        }
+    }
+
+    /// The name used in `--external` and `external.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fem => "fem",
+            Self::Sph => "sph",
+        }
+    }
 }
 
 /// `cosim check`.

@@ -12,7 +12,7 @@ use contact_broker::coordinator::{write_summary, Progress, RunInfo};
 use contact_broker::summary::Summary;
 use cosim_proto::scene::Scene;
 
-use crate::cli::RunArgs;
+use crate::cli::{ExternalNode, RunArgs};
 use crate::progress::Bar;
 
 /// How long the broker may take to open its session.
@@ -131,6 +131,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if scene.fluid.is_some() {
         wanted.push("sph-node");
     }
+    // An outside program takes that node's place (`--external`): it is not started here.
+    let external = args.external.map(ExternalNode::program);
+    wanted.retain(|n| Some(*n) != external);
     let programs = wanted
         .iter()
         .map(|n| Ok((*n, find_program(n)?)))
@@ -155,6 +158,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     }
     if let Some(c) = &args.connect {
         broker_args.extend(["--connect".into(), c.clone()]);
+    }
+    if args.external.is_some() {
+        broker_args.extend(["--wait-nodes".into(), args.wait_external.to_string()]);
     }
     let mut broker = spawn("contact-broker", &broker_bin, &broker_args, &broker_log, Stdio::piped())?;
     let (tx, rx) = mpsc::channel();
@@ -194,6 +200,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             .cloned()
             .ok_or_else(|| anyhow::anyhow!("contact-broker listens on no TCP endpoint ({endpoints:?})"))?,
     };
+    if let Some(node) = args.external {
+        announce_external(node, &info.run_id, &connect, args.wait_external, &info.out)?;
+    }
     let mut node_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
     if let Some(n) = args.threads {
         node_args.extend(["--threads".into(), n.to_string()]);
@@ -262,6 +271,21 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             Ok(summary)
         }
     }
+}
+
+/// Tell the user (stderr) and a script (`DIR/external.json`) how to join the run in place of `node`.
+fn announce_external(node: ExternalNode, run: &str, connect: &str, wait: f64, out: &Path) -> anyhow::Result<()> {
+    let path = out.join("external.json");
+    let doc = serde_json::json!({"node": node.name(), "run": run, "connect": connect, "wait_seconds": wait});
+    std::fs::write(&path, format!("{doc:#}\n")).with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!(
+        "cosim: waiting up to {wait} s for an external {} node to join run {run} at {connect} (as `{} --run {run} \
+         --connect {connect}` would; details in {})",
+        node.name(),
+        node.program(),
+        path.display()
+    );
+    Ok(())
 }
 
 fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {

@@ -11,7 +11,7 @@ use cosim_proto::scene::{self, LoadedScene};
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
-use crate::cli::RunArgs;
+use crate::cli::{ExternalNode, RunArgs};
 use crate::in_process;
 use crate::launch;
 use crate::progress::Bar;
@@ -27,6 +27,32 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     };
     if let Some(n) = args.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");
+    }
+    if let Some(node) = args.external {
+        anyhow::ensure!(
+            !args.in_process,
+            "--external {}: an outside program joins over zenoh, so it needs processes mode (drop --in-process)",
+            node.name()
+        );
+        let present = match node {
+            ExternalNode::Fem => !scene.scene.solids.is_empty(),
+            ExternalNode::Sph => scene.scene.fluid.is_some(),
+        };
+        anyhow::ensure!(
+            present,
+            "--external {}: {} has no {} for it to solve",
+            node.name(),
+            args.scene.display(),
+            match node {
+                ExternalNode::Fem => "[[solid]]",
+                ExternalNode::Sph => "[fluid]",
+            }
+        );
+        anyhow::ensure!(
+            args.wait_external.is_finite() && args.wait_external > 0.0,
+            "--wait-external must be a positive number of seconds, got {}",
+            args.wait_external
+        );
     }
     let out = args
         .out
