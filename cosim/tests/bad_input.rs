@@ -359,3 +359,40 @@ fn fluid_block_smaller_than_the_spacing() {
     );
     assert_refused("fluid_block", &text, "fluid.block[0]", "holds no particle");
 }
+
+#[test]
+fn external_node_refused_where_it_cannot_join_and_a_missing_one_fails_within_seconds() {
+    let path = write_scene("external", GOOD);
+    let out_dir = path.parent().unwrap().join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            path.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let out = cosim_run(&args, LIMIT);
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    // A structure-only scene has no fluid node to replace.
+    let (code, err) = run(&["--external", "sph"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--external sph") && err.contains("[fluid]"), "{err}");
+    // An outside program joins over zenoh: not in one process.
+    let (code, err) = run(&["--external", "fem", "--in-process"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--in-process"), "{err}");
+    // Nobody joins: the run fails once the wait is over, saying who did not come, and leaves a summary.
+    let started = Instant::now();
+    let (code, err) = run(&["--external", "fem", "--wait-external", "2"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("waiting up to 2 s for an external fem node"), "{err}");
+    assert!(err.contains("did not register within 2 s"), "{err}");
+    assert!(started.elapsed() < Duration::from_secs(20), "{:?}", started.elapsed());
+    assert_eq!(json(&out_dir.join("summary.json"))["status"], "failed");
+}
