@@ -68,7 +68,8 @@ impl Guard {
 impl Drop for Guard {
     fn drop(&mut self) {
         if self.exited().is_none() {
-            tracing::warn!("stopping {}", self.name);
+            // The run's outcome is already decided and reported; this only makes sure nothing outlives it.
+            tracing::debug!("stopping {}", self.name);
             let _ = self.child.kill();
             let _ = self.child.wait();
         }
@@ -260,13 +261,19 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             } else if let Some(reason) = broker_said.strip_prefix("contact-broker: ") {
                 reason.to_string()
             } else {
+                // It died without a word (killed, crashed): say how, then what the nodes saw.
+                let how = match std::os::unix::process::ExitStatusExt::signal(&broker_status) {
+                    Some(signal) => format!("contact-broker died (signal {signal})"),
+                    None => format!("contact-broker died ({broker_status})"),
+                };
                 let nodes: Vec<String> = wanted
                     .iter()
                     .map(|n| last_line(&logs.join(format!("{n}.log"))))
                     .collect();
-                format!("contact-broker: {broker_said}; {}", nodes.join("; "))
+                format!("{how}; {}", nodes.join("; "))
             };
-            let summary = failed_summary(info, message, started.elapsed().as_secs_f64());
+            let mut summary = failed_summary(info, message, started.elapsed().as_secs_f64());
+            kept_outputs(&info.out, &mut summary);
             write_summary(&info.out, &summary)?;
             Ok(summary)
         }
@@ -286,6 +293,35 @@ fn announce_external(node: ExternalNode, run: &str, connect: &str, wait: f64, ou
         path.display()
     );
     Ok(())
+}
+
+/// What a broker that died left on disk: the probe samples (rows of `probes.csv`, the last one's time) and the
+/// frames, so that the summary says what was kept.
+fn kept_outputs(out: &Path, summary: &mut Summary) {
+    if let Ok(text) = std::fs::read_to_string(out.join("probes.csv")) {
+        let rows: Vec<&str> = text.lines().skip(1).filter(|l| !l.trim().is_empty()).collect();
+        summary.samples = rows.len() as u64;
+        if let Some(t) = rows
+            .last()
+            .and_then(|l| l.split(',').next())
+            .and_then(|t| t.parse().ok())
+        {
+            summary.sim_time = t;
+        }
+    }
+    // One frame is one time: count the structure's files, or the particles' in a fluid-only run.
+    let count = |prefix: &str| {
+        std::fs::read_dir(out.join("frames")).map_or(0, |dir| {
+            dir.filter_map(Result::ok)
+                .filter(|e| {
+                    let name = e.file_name();
+                    let name = name.to_string_lossy();
+                    name.starts_with(prefix) && name.ends_with(".vtu")
+                })
+                .count() as u64
+        })
+    };
+    summary.frames = count("structure_").max(count("particles_"));
 }
 
 fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {

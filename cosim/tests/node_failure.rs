@@ -1,0 +1,172 @@
+//! Clean failure (`DESIGN.md` §3, `docs/PROTOCOL.md` §8): a coupled run as three processes loses one of them
+//! mid-run — `fem-node`, `sph-node` or `contact-broker` killed with SIGKILL, or `sph-node` frozen with SIGSTOP so
+//! that it stops answering. Each time `cosim run` must exit 1 within seconds with one line on stderr naming the
+//! process and what happened, `summary.json` must say `failed`, the probe samples and frames written before must
+//! still be there, and no process of the run may be left behind.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::*;
+
+/// Bound on every wait; no test may hang.
+const LIMIT: Duration = Duration::from_secs(120);
+/// The coarse gate (875 particles), long enough never to finish before the failure.
+const SCENE: &str = "scenes/elastic_gate.toml";
+const SETS: [&str; 4] = [
+    "fluid.spacing=0.004",
+    "run.end_time=10",
+    // A frozen node is declared dead after this long without an answer.
+    "coupling.step_timeout=2",
+    "run.output_interval=0.005",
+];
+
+/// Kills the child when dropped.
+struct Kill(Child);
+
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The pids and program names of `pid`'s children.
+fn children(pid: u32) -> Vec<(u32, String)> {
+    let mut out = Vec::new();
+    for task in std::fs::read_dir(format!("/proc/{pid}/task"))
+        .into_iter()
+        .flatten()
+        .flatten()
+    {
+        let list = std::fs::read_to_string(task.path().join("children")).unwrap_or_default();
+        for child in list.split_whitespace().filter_map(|c| c.parse::<u32>().ok()) {
+            let name = std::fs::read_to_string(format!("/proc/{child}/comm")).unwrap_or_default();
+            out.push((child, name.trim().to_string()));
+        }
+    }
+    out
+}
+
+/// Whether `pid` is still a live process (not gone, not a zombie).
+fn alive(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .map(|s| s.rsplit_once(") ").is_some_and(|(_, rest)| !rest.starts_with('Z')))
+        .unwrap_or(false)
+}
+
+/// Data rows of `probes.csv` so far.
+fn samples(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().skip(1).count())
+}
+
+/// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
+fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
+    let dir = scratch(&format!("failure-{name}"));
+    let out = dir.join("out");
+    let stderr_path = dir.join("stderr.txt");
+    let mut cmd = Command::new(cosim());
+    cmd.current_dir(root())
+        .env("COSIM_BIN_DIR", bin_dir())
+        .args(["run", SCENE, "--quiet", "--out"])
+        .arg(&out)
+        .args(["--run-id", &run_id(name)]);
+    for s in SETS {
+        cmd.args(["--set", s]);
+    }
+    let mut run = Kill(
+        cmd.stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&stderr_path).unwrap())
+            .spawn()
+            .unwrap(),
+    );
+    let started = Instant::now();
+    // Under way: three children, and a few samples written.
+    let kids = loop {
+        let kids = children(run.0.id());
+        if kids.len() == 3 && samples(&out) >= 3 {
+            break kids;
+        }
+        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
+        assert!(started.elapsed() < LIMIT, "the run did not get going: {kids:?}");
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let (pid, _) = kids
+        .iter()
+        .find(|(_, n)| n == victim)
+        .unwrap_or_else(|| panic!("{victim} not in {kids:?}"));
+    let kept = samples(&out);
+    let hit = Instant::now();
+    let sent = Command::new("kill").args([signal, &pid.to_string()]).status().unwrap();
+    assert!(sent.success());
+    let status = loop {
+        if let Some(s) = run.0.try_wait().unwrap() {
+            break s;
+        }
+        assert!(hit.elapsed() < LIMIT, "cosim did not stop after {victim} got {signal}");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let took = hit.elapsed();
+    let stderr = std::fs::read_to_string(&stderr_path).unwrap();
+    eprintln!(
+        "{name}: cosim exited {took:.2?} after {signal} to {victim}: {}",
+        stderr.trim()
+    );
+    assert_eq!(status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
+    for word in expect {
+        assert!(lines[0].contains(word), "{word:?} not in {stderr}");
+    }
+    // The broker's step timeout is 2 s and its liveliness check is immediate: seconds, not minutes.
+    assert!(took < Duration::from_secs(30), "{took:?}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    assert!(samples(&out) >= kept, "samples lost: {} < {kept}", samples(&out));
+    assert!(summary["samples"].as_u64().unwrap() >= kept as u64, "{summary}");
+    assert!(out.join("frames").read_dir().unwrap().count() >= 3);
+    // Nothing is left running (a stopped process counts).
+    let until = Instant::now() + Duration::from_secs(10);
+    while kids.iter().any(|(p, _)| alive(*p)) && Instant::now() < until {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let left: Vec<_> = kids.iter().filter(|(p, _)| alive(*p)).collect();
+    for (p, _) in &left {
+        let _ = Command::new("kill").args(["-9", &p.to_string()]).status();
+    }
+    assert!(left.is_empty(), "left running: {left:?}");
+}
+
+#[test]
+fn fem_node_killed() {
+    lose("fem_killed", "fem-node", "-KILL", &["fem-node", "died"]);
+}
+
+#[test]
+fn sph_node_killed() {
+    lose("sph_killed", "sph-node", "-KILL", &["sph-node", "died"]);
+}
+
+#[test]
+fn broker_killed() {
+    lose(
+        "broker_killed",
+        "contact-broker",
+        "-KILL",
+        &["contact-broker died (signal 9)"],
+    );
+}
+
+#[test]
+fn sph_node_frozen() {
+    lose(
+        "sph_frozen",
+        "sph-node",
+        "-STOP",
+        &["sph-node", "no answer", "coupling.step_timeout"],
+    );
+}
