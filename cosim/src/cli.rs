@@ -22,6 +22,12 @@ pub enum Command {
     Check(CheckArgs),
     /// Draw one probe of several finished runs in one plot (and print its extremes per run).
     Compare(CompareArgs),
+    /// Run the benchmark suite: run time, memory and error of the validation scenes at several spacings, and
+    /// cost per particle-step at four sizes (writes DIR/bench.json, DIR/report.md, DIR/pareto.svg).
+    Bench(BenchArgs),
+    /// One case of `cosim bench`: `cosim run` that also writes its peak resident memory and CPU time to a file.
+    #[command(hide = true)]
+    BenchRun(BenchRunArgs),
 }
 
 /// `cosim run`.
@@ -111,4 +117,47 @@ pub struct CompareArgs {
     /// SVG file to write.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `cosim bench`.
+#[derive(Args, Debug, Clone)]
+pub struct BenchArgs {
+    /// The quick suite: coarse spacings and short end times (under 10 minutes on 2 cores).
+    #[arg(long)]
+    pub quick: bool,
+    /// Output folder: bench.json, report.md, pareto.svg, and each case's run under runs/.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Run only these cases (dam_break, hydrostatic_plate, elastic_gate, scaling; repeatable or comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
+    /// Run only these fluid solvers (wcsph, isph).
+    #[arg(long, value_delimiter = ',')]
+    pub solver: Vec<String>,
+    /// Run the gate only with these contact algorithms (particle_element, particle_particle).
+    #[arg(long, value_delimiter = ',')]
+    pub contact: Vec<String>,
+    /// Replace the suite's spacings [m] of every case but scaling.
+    #[arg(long, value_delimiter = ',')]
+    pub spacing: Vec<f64>,
+    /// Replace the suite's end time [s] of every case but scaling.
+    #[arg(long)]
+    pub end_time: Option<f64>,
+    /// Folder of the scenes and their reference data.
+    #[arg(long, default_value = "scenes")]
+    pub scenes: PathBuf,
+    /// Stop a case after this many seconds (default 300 quick, 3600 full); it is recorded as `timeout`.
+    #[arg(long)]
+    pub case_timeout: Option<u64>,
+}
+
+/// `cosim bench-run`.
+#[derive(Args, Debug, Clone)]
+pub struct BenchRunArgs {
+    /// The run.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// File to write the process's peak resident memory and CPU time to (JSON).
+    #[arg(long)]
+    pub stats_out: PathBuf,
 }

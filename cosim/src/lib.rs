@@ -2,6 +2,7 @@
 //! overlays a probe of several runs (`compare`).
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod check;
 pub mod cli;
 pub mod compare;

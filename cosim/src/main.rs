@@ -1,4 +1,4 @@
-//! `cosim`: run, check, compare.
+//! `cosim`: run, check, compare, bench.
 
 use std::process::ExitCode;
 
@@ -15,6 +15,8 @@ fn main() -> ExitCode {
         Command::Run(args) => cosim::run::run(&args),
         Command::Check(args) => cosim::check::check(&args),
         Command::Compare(args) => cosim::compare::compare(&args),
+        Command::Bench(args) => cosim::bench::bench(&args),
+        Command::BenchRun(args) => cosim::bench::bench_run(&args),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,78 @@
+//! One line of `DIR/bench.json`: what ran, how long it took, how much memory, how far from its reference.
+
+use std::path::Path;
+
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+/// One bench case's result. A case that failed or blew up is a record too, with `status` and `message`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Record {
+    /// `dam_break` | `hydrostatic_plate` | `elastic_gate` | `scaling`.
+    pub case: String,
+    /// `wcsph` | `isph`.
+    pub solver: String,
+    /// `particle_element` | `particle_particle` | `none` (no structure).
+    pub contact: String,
+    /// Fluid particle spacing [m].
+    pub spacing: f64,
+    /// Worker threads of the run.
+    pub threads: usize,
+    /// Fluid particles.
+    pub particles: u64,
+    /// Fluid (SPH) steps taken.
+    pub steps: u64,
+    /// Coupling steps taken (the broker's steps).
+    pub coupling_steps: u64,
+    /// Simulated time reached [s].
+    pub sim_time: f64,
+    /// Simulated end time asked for [s].
+    pub end_time: f64,
+    /// Wall time of the run as `summary.json` reports it (set-up to last output) [s].
+    pub wall_seconds: f64,
+    /// Wall time of the whole child process, start to exit [s].
+    pub process_seconds: f64,
+    /// particles × steps / wall_seconds.
+    pub particle_steps_per_second: f64,
+    /// Seconds the fluid node spent computing (`summary.json` timings.sph).
+    pub sph_seconds: f64,
+    /// sph_seconds / (particles × steps) [ns]: the fluid's cost per particle-step, outputs and set-up left out.
+    pub sph_ns_per_particle_step: f64,
+    /// Relative error against the case's reference (see `metric`); `null` when not measured.
+    pub error: Option<f64>,
+    /// The worst pointwise relative error, where the metric has points (the dam break); else `null`.
+    pub error_max: Option<f64>,
+    /// The measured quantity the error is computed from (front error has none: `null`).
+    pub value: Option<f64>,
+    /// The reference value (`null` for a curve).
+    pub reference: Option<f64>,
+    /// How `error` is computed.
+    pub metric: String,
+    /// Peak resident memory of the run's process (VmHWM) [bytes].
+    pub peak_rss_bytes: Option<u64>,
+    /// CPU time of the run's process, all threads [s].
+    pub cpu_seconds: Option<f64>,
+    /// The machine's 1-minute load average when the case started (the bench itself adds about 1).
+    pub load_average: Option<f64>,
+    /// `ok` | `unstable` | `failed` | `timeout`.
+    pub status: String,
+    /// One line: the run's message, or why the case has no result.
+    pub message: String,
+    /// The `--set` overrides the case ran with.
+    pub sets: Vec<String>,
+    /// The run's output folder.
+    pub out: String,
+}
+
+impl Record {
+    /// Whether the case ran to its end time with a finite error.
+    pub fn ok(&self) -> bool {
+        self.status == "ok" && self.error.is_some_and(f64::is_finite)
+    }
+}
+
+/// Write `records` as a pretty JSON list.
+pub fn write(path: &Path, records: &[Record]) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(records)?;
+    std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,162 @@
+//! `cosim bench` end to end on a tiny selection of the suite: bench.json's records, the error falling with
+//! spacing on the dam break, a blown-up case recorded instead of stopping the bench, report.md and pareto.svg.
+
+mod common;
+
+use std::path::Path;
+use std::time::Duration;
+
+use common::*;
+
+const LIMIT: Duration = Duration::from_secs(120);
+
+/// The fields every record has, numeric ones finite.
+const NUMBERS: [&str; 7] = [
+    "spacing",
+    "particles",
+    "steps",
+    "wall_seconds",
+    "particle_steps_per_second",
+    "peak_rss_bytes",
+    "threads",
+];
+
+fn bench(name: &str, args: &[&str]) -> (std::process::Output, std::path::PathBuf) {
+    let out = scratch(name).join("bench");
+    let mut all = vec!["bench", "--quick", "--out", out.to_str().unwrap()];
+    all.extend(args);
+    let mut cmd = std::process::Command::new(cosim());
+    cmd.current_dir(root()).args(&all).env("COSIM_BIN_DIR", bin_dir());
+    (run_bounded(&mut cmd, LIMIT), out)
+}
+
+fn records(out: &Path) -> Vec<serde_json::Value> {
+    let list = json(&out.join("bench.json"));
+    let list = list.as_array().expect("bench.json is a list").clone();
+    for r in &list {
+        for key in ["case", "solver", "contact", "status", "message"] {
+            assert!(r[key].is_string(), "{key} in {r}");
+        }
+        for key in NUMBERS {
+            let v = r[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{key} is not a number in {r}"));
+            assert!(v.is_finite() && v >= 0.0, "{key} = {v}");
+        }
+        assert!(r.get("error").is_some(), "error (a number or null) in {r}");
+    }
+    list
+}
+
+/// A minimal well-formedness check of an SVG document: one `<svg>` root, every tag closed in order.
+fn assert_svg(text: &str) {
+    let mut open: Vec<String> = Vec::new();
+    let mut rest = text;
+    let mut tags = 0;
+    while let Some(k) = rest.find('<') {
+        let end = rest[k..].find('>').expect("an unterminated tag") + k;
+        let tag = &rest[k + 1..end];
+        rest = &rest[end + 1..];
+        if tag.starts_with('?') || tag.starts_with('!') {
+            continue;
+        }
+        tags += 1;
+        let name = |t: &str| {
+            t.split(|c: char| c.is_whitespace() || c == '/')
+                .next()
+                .unwrap_or("")
+                .to_string()
+        };
+        if let Some(closing) = tag.strip_prefix('/') {
+            assert_eq!(
+                open.pop().as_deref(),
+                Some(closing.trim()),
+                "tag </{closing}> closes nothing open"
+            );
+        } else if !tag.ends_with('/') {
+            open.push(name(tag));
+        }
+        if open.is_empty() {
+            assert!(rest.trim().is_empty(), "content after the root element");
+        }
+    }
+    assert!(open.is_empty(), "unclosed tags {open:?}");
+    assert!(text.contains("<svg") && tags > 10, "an SVG with a drawing");
+}
+
+#[test]
+fn dam_break_error_falls_with_spacing_and_outputs_are_written() {
+    let (output, out) = bench(
+        "db",
+        &["--only", "dam_break", "--solver", "wcsph", "--spacing", "0.01,0.005"],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "cosim bench failed: {stderr}");
+    // One progress line per case.
+    assert_eq!(stderr.lines().filter(|l| l.starts_with('[')).count(), 2, "{stderr}");
+    let list = records(&out);
+    assert_eq!(list.len(), 2);
+    let error = |r: &serde_json::Value| r["error"].as_f64().expect("a dam-break error");
+    for r in &list {
+        assert_eq!(r["case"], "dam_break");
+        assert_eq!(r["solver"], "wcsph");
+        assert_eq!(r["contact"], "none");
+        assert_eq!(r["status"], "ok", "{r}");
+        assert!(r["particles"].as_u64().unwrap() > 0 && r["steps"].as_u64().unwrap() > 0);
+        assert!(
+            r["peak_rss_bytes"].as_u64().unwrap() > 1 << 20,
+            "peak RSS of a real process"
+        );
+        assert!(error(r).is_finite() && error(r) > 0.0);
+    }
+    // 200 particles at Δx = a/10: 7.5 %; 800 at a/20: 3.9 % (mean front error, shifted experiment).
+    let (coarse, fine) = (error(&list[0]), error(&list[1]));
+    eprintln!("dam-break front error: {coarse:.4} at 0.01 m, {fine:.4} at 0.005 m");
+    assert!(fine < 0.7 * coarse, "refining should cut the error: {coarse} -> {fine}");
+    assert!(coarse < 0.15, "even a/10 follows the experiment to 15 %: {coarse}");
+    assert!(list[1]["particles"].as_u64() > list[0]["particles"].as_u64());
+
+    let report = std::fs::read_to_string(out.join("report.md")).expect("report.md");
+    assert!(
+        report.contains("| dam_break | wcsph | none | 0.005 | 800 |"),
+        "{report}"
+    );
+    assert!(
+        report.contains("Martin & Moyce"),
+        "the report states the error definition"
+    );
+    assert_svg(&std::fs::read_to_string(out.join("pareto.svg")).expect("pareto.svg"));
+}
+
+#[test]
+fn a_blown_up_case_is_a_record_not_an_abort() {
+    // The plate's side walls are 0.075 m thick: at 0.05 m spacing they hold 1.5 layers and particles leak out at
+    // once; at 0.025 m the run is sound.
+    let (output, out) = bench(
+        "unstable",
+        &[
+            "--only",
+            "hydrostatic_plate",
+            "--solver",
+            "wcsph",
+            "--spacing",
+            "0.05,0.025",
+            "--end-time",
+            "0.06",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "some case failed: {stderr}");
+    let list = records(&out);
+    assert_eq!(list.len(), 2, "the bench went on after the failure");
+    assert_eq!(list[0]["status"], "unstable", "{}", list[0]);
+    assert!(list[0]["message"].as_str().unwrap().contains("sph-node"), "{}", list[0]);
+    assert!(list[0]["error"].is_null(), "no error for a blown-up run");
+    assert_eq!(list[1]["status"], "ok", "{}", list[1]);
+    assert_eq!(list[1]["contact"], "particle_element");
+    let w = list[1]["value"].as_f64().unwrap();
+    assert!(w < 0.0 && w.is_finite(), "the plate sags: {w}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("**unstable**"), "{report}");
+    assert_svg(&std::fs::read_to_string(out.join("pareto.svg")).unwrap());
+}
