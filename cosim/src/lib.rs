@@ -1,5 +1,5 @@
 //! The `cosim` command: launches a scene as processes or in one process (`run`), validates it (`check`),
-//! overlays a probe of several runs (`compare`).
+//! overlays a probe of several runs (`compare`), measures run time against error over a suite of scenes (`bench`).
 #![warn(missing_docs)]
 
 pub mod bench;

@@ -35,7 +35,9 @@ pub fn plot(path: &Path, records: &[Record]) -> anyhow::Result<()> {
         }
     };
     let (x0, x1) = span(|p| p.0, (0.1, 100.0));
+    // Room below the points for the legend (lower left: fast and accurate, where few points fall).
     let (y0, y1) = span(|p| p.1, (1e-3, 1.0));
+    let y0 = y0 / 4.0;
     let mut svg = String::new();
     let drawn = (|| -> Result<(), String> {
         let err = |e: &dyn std::fmt::Display| e.to_string();
@@ -52,6 +54,9 @@ pub fn plot(path: &Path, records: &[Record]) -> anyhow::Result<()> {
             .configure_mesh()
             .x_desc("wall time [s]")
             .y_desc("relative error")
+            .light_line_style(WHITE)
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
             .draw()
             .map_err(|e| err(&e))?;
         for (k, (label, points)) in curves.iter().enumerate() {
@@ -72,7 +77,7 @@ pub fn plot(path: &Path, records: &[Record]) -> anyhow::Result<()> {
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .draw()
@@ -81,4 +86,22 @@ pub fn plot(path: &Path, records: &[Record]) -> anyhow::Result<()> {
     })();
     drawn.map_err(|m| anyhow::anyhow!("{}: cannot draw: {m}", path.display()))?;
     std::fs::write(path, svg).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// A tick label without the binary round-off of the log axis' tick values (0.30000000000000004 → 0.3).
+fn short(v: f64) -> String {
+    let text = format!("{:.3e}", v);
+    text.parse::<f64>().map_or(text, |r| r.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_drop_round_off() {
+        assert_eq!(short(0.30000000000000004), "0.3");
+        assert_eq!(short(20.0), "20");
+        assert_eq!(short(0.0123456), "0.01235");
+    }
 }

@@ -18,6 +18,8 @@ pub struct Record {
     pub spacing: f64,
     /// Worker threads of the run.
     pub threads: usize,
+    /// Runs of this case; the record is the one with the median `sph_ns_per_particle_step`.
+    pub repeats: usize,
     /// Fluid particles.
     pub particles: u64,
     /// Fluid (SPH) steps taken.

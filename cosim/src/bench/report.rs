@@ -194,7 +194,9 @@ fn scaling_section(md: &mut String, records: &[Record]) {
     let _ = writeln!(
         md,
         "Cost per particle-step is the fluid node's compute time (`timings.sph`) over particles × steps: set-up \
-         and frame writing are left out. `particle-steps/s` divides by the run's whole wall time instead.\n"
+         and frame writing are left out. `particle-steps/s` divides by the run's whole wall time instead. Each \
+         row is the median of {} runs by cost.\n",
+        rows.first().map_or(1, |r| r.repeats)
     );
     let _ = writeln!(
         md,

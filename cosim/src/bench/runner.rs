@@ -37,6 +37,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         contact: case.contact.into(),
         spacing: case.spacing,
         threads: case.threads.unwrap_or_else(rayon::current_num_threads),
+        repeats: 1,
         particles: 0,
         steps: 0,
         coupling_steps: 0,

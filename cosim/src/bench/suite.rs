@@ -36,6 +36,9 @@ pub struct Case {
     pub end_time: f64,
     /// Worker threads (`--threads`); `None`: all cores.
     pub threads: Option<usize>,
+    /// Runs of the case; the record kept is the one with the median fluid cost per particle-step (the scaling
+    /// runs are short, and another program taking a core for a second would skew a single one).
+    pub repeats: usize,
     /// Further `--set` overrides beyond solver, contact, spacing and end time.
     pub extra: Vec<String>,
     /// Reference the error is computed against.
@@ -122,6 +125,7 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
                 spacing,
                 end_time: sel.end_time.unwrap_or(end_time),
                 threads: None,
+                repeats: 1,
                 extra: extra.iter().map(|s| s.to_string()).collect(),
                 metric,
             });
@@ -186,6 +190,7 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
                 spacing,
                 end_time: scaling_end(spacing),
                 threads: Some(threads),
+                repeats: SCALING_REPEATS,
                 extra: vec![format!("run.output_interval={}", scaling_end(spacing))],
                 metric: Metric::Scaling,
             });
@@ -199,6 +204,9 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
     });
     cases
 }
+
+/// Runs of each scaling case (the median is kept).
+const SCALING_REPEATS: usize = 3;
 
 /// End time of a scaling run at `spacing`: about [`SCALING_STEPS`] WCSPH steps, rounded to 1e-5 s.
 fn scaling_end(spacing: f64) -> f64 {
