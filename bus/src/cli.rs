@@ -1,4 +1,4 @@
-//! The command line every solver node binary shares: `--run ID --connect ENDPOINT [--threads N]`.
+//! The command line every solver node binary shares: `--run ID --connect ENDPOINT [--client] [--threads N]`.
 
 use clap::Parser;
 use cosim_proto::keys::NodeTopics;
@@ -25,6 +25,9 @@ struct Args {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// `--connect` is a zenoh router (`zenohd`): join through it as a client, as every process of the run must.
+    #[arg(long, conflicts_with = "listen")]
+    client: bool,
 }
 
 /// The whole `main` of a node binary: parse the arguments, serve, and exit non-zero with one line on stderr.
@@ -48,6 +51,7 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
         connect: args.connect,
         listen: args.listen,
         timeout_ms: (args.timeout * 1000.0) as u64,
+        client: args.client,
     };
     match serve(&opts, topics, build) {
         Ok(()) => std::process::exit(0),

@@ -25,6 +25,8 @@ pub struct NodeOptions {
     pub listen: Vec<String>,
     /// Milliseconds to wait for a connection and for the scene.
     pub timeout_ms: u64,
+    /// Join as a zenoh client through the router at `connect` (a run spread over hosts) instead of as a peer.
+    pub client: bool,
 }
 
 /// A node's failure: a numerical blow-up (`unstable`) or anything else.
@@ -69,8 +71,11 @@ pub fn serve<C: NodeCore>(
     topics: NodeTopics,
     build: impl FnOnce(&Scene) -> Result<C, Failure>,
 ) -> anyhow::Result<()> {
-    let session = crate::session::open_session(&opts.listen, &opts.connect, opts.timeout_ms)
-        .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
+    let session = match opts.client {
+        true => crate::session::open_client(&opts.connect, opts.timeout_ms),
+        false => crate::session::open_session(&opts.listen, &opts.connect, opts.timeout_ms),
+    }
+    .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
     let run = opts.run.as_str();
     let errors = session
         .declare_publisher(key(run, topics.error))

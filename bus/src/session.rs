@@ -15,6 +15,22 @@ pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> a
     zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
+/// Open a client session through the router(s) at `connect` (`cosim_proto::session::client_settings`): how every
+/// process of a run joins when the run goes through a router instead of peer to peer.
+pub fn open_client(connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
+    anyhow::ensure!(
+        !connect.is_empty(),
+        "client mode needs a router to connect to (--connect)"
+    );
+    let mut config = zenoh::Config::default();
+    for (k, v) in cosim_proto::session::client_settings(connect, timeout_ms) {
+        config
+            .insert_json5(&k, &v)
+            .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
+    }
+    zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
+}
+
 /// Open a session that listens. A TCP listen endpoint with port 0 gets a free port picked here (zenoh's own
 /// listing of bound locators is an unstable API), retried a few times in case another program takes it first.
 /// Returns the session and the endpoints it listens on.

@@ -37,6 +37,10 @@ struct Args {
     /// Endpoints (a router or peers) to connect to.
     #[arg(long)]
     connect: Vec<String>,
+    /// `--connect` is a zenoh router (`zenohd`): join through it as a client and listen on nothing; the nodes
+    /// then join through the same router with `--client`.
+    #[arg(long)]
+    client: bool,
     /// Seconds to wait for the nodes to register.
     #[arg(long, default_value_t = 60.0)]
     wait_nodes: f64,
@@ -71,12 +75,17 @@ fn run(args: Args) -> anyhow::Result<()> {
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
     coordinator::check_supported(&scene)?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let (session, endpoints) = transport::open_listening(&args.listen, &args.connect, 5000).with_context(|| {
-        format!(
-            "cannot open a zenoh session (listen {:?}, connect {:?})",
-            args.listen, args.connect
-        )
-    })?;
+    let (session, endpoints) = match args.client {
+        true => transport::open_client(&args.connect, 5000)
+            .map(|s| (s, Vec::new()))
+            .with_context(|| format!("cannot join the router {:?}", args.connect))?,
+        false => transport::open_listening(&args.listen, &args.connect, 5000).with_context(|| {
+            format!(
+                "cannot open a zenoh session (listen {:?}, connect {:?})",
+                args.listen, args.connect
+            )
+        })?,
+    };
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
     let fem_subs = match scene.scene.solids.is_empty() {
         false => Some(transport::subscribe(&session, &args.run, cosim_proto::keys::FEM)?),

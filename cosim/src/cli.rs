@@ -47,7 +47,7 @@ pub struct RunArgs {
     /// Run id (default: a fresh one).
     #[arg(long)]
     pub run_id: Option<String>,
-    /// Connect every node to this zenoh endpoint (a router) instead of peer-to-peer on loopback.
+    /// Connect every node to this zenoh router (e.g. `zenohd`) as a zenoh client instead of peer-to-peer on loopback.
     #[arg(long)]
     pub connect: Option<String>,
     /// Worker threads per node (default: all cores).

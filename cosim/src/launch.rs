@@ -157,8 +157,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     for s in &args.set {
         broker_args.extend(["--set".into(), s.clone()]);
     }
+    // Through a router every process is a zenoh client (see `cosim_proto::session::client_settings`).
     if let Some(c) = &args.connect {
-        broker_args.extend(["--connect".into(), c.clone()]);
+        broker_args.extend(["--connect".into(), c.clone(), "--client".into()]);
     }
     if args.external.is_some() {
         broker_args.extend(["--wait-nodes".into(), args.wait_external.to_string()]);
@@ -202,9 +203,13 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             .ok_or_else(|| anyhow::anyhow!("contact-broker listens on no TCP endpoint ({endpoints:?})"))?,
     };
     if let Some(node) = args.external {
-        announce_external(node, &info.run_id, &connect, args.wait_external, &info.out)?;
+        let mode = if args.connect.is_some() { "client" } else { "peer" };
+        announce_external(node, &info.run_id, &connect, mode, args.wait_external, &info.out)?;
     }
     let mut node_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
+    if args.connect.is_some() {
+        node_args.push("--client".into());
+    }
     if let Some(n) = args.threads {
         node_args.extend(["--threads".into(), n.to_string()]);
     }
@@ -281,13 +286,23 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
 }
 
 /// Tell the user (stderr) and a script (`DIR/external.json`) how to join the run in place of `node`.
-fn announce_external(node: ExternalNode, run: &str, connect: &str, wait: f64, out: &Path) -> anyhow::Result<()> {
+/// `mode` is the zenoh mode to join in: `peer` (connecting to the broker) or `client` (through a router).
+fn announce_external(
+    node: ExternalNode,
+    run: &str,
+    connect: &str,
+    mode: &str,
+    wait: f64,
+    out: &Path,
+) -> anyhow::Result<()> {
     let path = out.join("external.json");
-    let doc = serde_json::json!({"node": node.name(), "run": run, "connect": connect, "wait_seconds": wait});
+    let doc =
+        serde_json::json!({"node": node.name(), "run": run, "connect": connect, "mode": mode, "wait_seconds": wait});
     std::fs::write(&path, format!("{doc:#}\n")).with_context(|| format!("cannot write {}", path.display()))?;
+    let flag = if mode == "client" { " --client" } else { "" };
     eprintln!(
         "cosim: waiting up to {wait} s for an external {} node to join run {run} at {connect} (as `{} --run {run} \
-         --connect {connect}` would; details in {})",
+         --connect {connect}{flag}` would; details in {})",
         node.name(),
         node.program(),
         path.display()

@@ -220,6 +220,8 @@ def main():
     ap.add_argument("--stiffness", type=float, default=3.0e8, help="spring stiffness k [N/m per m] (default 3e8)")
     ap.add_argument("--damping-ratio", type=float, default=0.1, help="zeta of the dry body (default 0.1)")
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for any one command")
+    ap.add_argument("--client", action="store_true",
+                    help="--connect is a zenoh router: join through it as a client (docs/PROTOCOL.md section 1)")
     args = ap.parse_args()
     if args.from_file:
         deadline = time.monotonic() + args.timeout
@@ -233,15 +235,18 @@ def main():
                     sys.exit(f"rigid_plate_node: no {args.from_file} after {args.timeout} s")
                 time.sleep(0.05)
         args.run, args.connect = info["run"], info["connect"]
+        args.client = args.client or info.get("mode") == "client"
     if not args.run or not args.connect:
         sys.exit("rigid_plate_node: give --run and --connect, or --from DIR/external.json")
 
-    conf = zenoh.Config.from_json5(json.dumps({
-        "mode": "peer",
+    settings = {
+        "mode": "client" if args.client else "peer",
         "scouting": {"multicast": {"enabled": False}},
         "connect": {"endpoints": [args.connect], "timeout_ms": 5000, "exit_on_failure": True},
-        "listen": {"endpoints": []},
-    }))
+    }
+    if not args.client:
+        settings["listen"] = {"endpoints": []}
+    conf = zenoh.Config.from_json5(json.dumps(settings))
     session = zenoh.open(conf)
     base = f"cosim/{args.run}"
     inbox = queue.Queue()

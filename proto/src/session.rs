@@ -25,3 +25,19 @@ pub fn peer_settings(listen: &[String], connect: &[String], timeout_ms: u64) -> 
     }
     s
 }
+
+/// Settings of a client session, for a process that joins a run through a zenoh router (`zenohd`, or any process
+/// in router mode) on another host: every message goes through the router. Peers connected to a router do not get
+/// each other's messages through it in zenoh 1.10 (the router stops brokering between peers it believes have met
+/// through gossip, and ours listen on nothing), so a run spread over hosts puts every process in client mode.
+/// Multicast scouting off; a router that does not answer within `timeout_ms` is an error.
+pub fn client_settings(connect: &[String], timeout_ms: u64) -> Vec<(String, String)> {
+    let quoted: Vec<String> = connect.iter().map(|e| format!("{e:?}")).collect();
+    vec![
+        ("mode".to_string(), "\"client\"".to_string()),
+        ("scouting/multicast/enabled".to_string(), "false".to_string()),
+        ("connect/endpoints".to_string(), format!("[{}]", quoted.join(","))),
+        ("connect/timeout_ms".to_string(), timeout_ms.to_string()),
+        ("connect/exit_on_failure".to_string(), "true".to_string()),
+    ]
+}
