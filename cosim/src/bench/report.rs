@@ -120,8 +120,8 @@ fn cases_section(md: &mut String, cases: &[Case]) {
                     " (published SPH–FEM and SPH peaks span 0.039–0.043 m); `error` = |peak − 0.043| / 0.043"
                 }
                 Metric::Scaling => {
-                    "; the WCSPH dam break at ~5,000 to ~100,000 particles for ~100 steps, one frame at the start \
-                     and one at the end"
+                    "; the WCSPH dam break at ~5,000 to ~100,000 particles for ~60 steps (quick) or ~200 (full), \
+                     one frame at the start and one at the end"
                 }
             };
             let _ = writeln!(md, "- **{}**: {}{}.", c.case, describe(c.metric), detail);

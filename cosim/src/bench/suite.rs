@@ -97,8 +97,8 @@ pub const CASES: [&str; 4] = ["dam_break", "hydrostatic_plate", "elastic_gate", 
 const SCALING_SPACINGS: [f64; 4] = [0.002, 0.001, 0.000632, 0.000447];
 
 /// WCSPH's stable step on the dam break is about 0.0148 Δx (measured: 4,062 steps to 0.2 s at Δx = 0.0033 m);
-/// scaling runs end after about this many steps.
-const SCALING_STEPS: f64 = 100.0;
+/// scaling runs end after about this many steps (quick, full).
+const SCALING_STEPS: (f64, f64) = (60.0, 200.0);
 
 /// The suite for `sel`, reading the scenes in `scenes`.
 pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
@@ -188,10 +188,10 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
                 solver: "wcsph",
                 contact: "none",
                 spacing,
-                end_time: scaling_end(spacing),
+                end_time: scaling_end(spacing, q),
                 threads: Some(threads),
                 repeats: SCALING_REPEATS,
-                extra: vec![format!("run.output_interval={}", scaling_end(spacing))],
+                extra: vec![format!("run.output_interval={}", scaling_end(spacing, q))],
                 metric: Metric::Scaling,
             });
         }
@@ -209,8 +209,9 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
 const SCALING_REPEATS: usize = 3;
 
 /// End time of a scaling run at `spacing`: about [`SCALING_STEPS`] WCSPH steps, rounded to 1e-5 s.
-fn scaling_end(spacing: f64) -> f64 {
-    (SCALING_STEPS * 0.0148 * spacing * 1e5).round() / 1e5
+fn scaling_end(spacing: f64, quick: bool) -> f64 {
+    let steps = if quick { SCALING_STEPS.0 } else { SCALING_STEPS.1 };
+    (steps * 0.0148 * spacing * 1e5).round() / 1e5
 }
 
 /// What a case runs, in words, for `report.md`.
