@@ -56,8 +56,13 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<ExitCode> {
                     _ => format!("{}_r{}", case.id(), rep + 1),
                 };
                 let load = load_average();
-                let mut r = runner::run_case(case, &args.out.join("runs").join(id), &args.scenes, limit);
+                let out = args.out.join("runs").join(id);
+                let mut r = runner::run_case(case, &out, &args.scenes, limit);
                 r.load_average = load;
+                if case.metric == suite::Metric::Scaling {
+                    // Two frames of up to 100,000 particles (~35 MB) per run that nobody looks at.
+                    let _ = std::fs::remove_dir_all(out.join("frames"));
+                }
                 r.repeats = case.repeats.max(1);
                 r
             })
