@@ -14,6 +14,8 @@ use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
 use zenoh::{Session, Wait};
 
+use crate::status::{serve_status, Board};
+
 /// Where to join.
 #[derive(Clone, Debug)]
 pub struct NodeOptions {
@@ -58,6 +60,11 @@ pub trait NodeCore {
 
     /// Apply the command's corrections, advance, answer; `None` for a stop command.
     fn handle(&mut self, cmd: &StepCommand) -> Result<Option<Self::State>, Failure>;
+
+    /// Sizes for the live status (particles, nodes, elements, …).
+    fn counts(&self) -> Vec<(&'static str, u64)> {
+        Vec::new()
+    }
 }
 
 fn zerr(e: zenoh::Error) -> anyhow::Error {
@@ -77,6 +84,9 @@ pub fn serve<C: NodeCore>(
     }
     .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
     let run = opts.run.as_str();
+    // Live status (`cosim inspect`), answered from the start; a failure is written on it before the exit.
+    let board = Board::new(topics.name, run);
+    let _status = serve_status(&session, key(run, topics.status), board.clone())?;
     let errors = session
         .declare_publisher(key(run, topics.error))
         .congestion_control(CongestionControl::Block)
@@ -89,7 +99,13 @@ pub fn serve<C: NodeCore>(
         };
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
     };
-    let result = serve_session(&session, opts, topics, build, &report);
+    let result = serve_session(&session, opts, topics, build, &report, &board);
+    board.update(|s| {
+        s.health = if result.is_ok() { "finished" } else { "failed" }.into();
+        if let Err(e) = &result {
+            s.message = format!("{e:#}").replace('\n', " ");
+        }
+    });
     if let Err(e) = &result {
         let unstable = e.downcast_ref::<Failure>().is_some_and(|f| f.unstable);
         report(
@@ -108,6 +124,7 @@ fn serve_session<C: NodeCore>(
     topics: NodeTopics,
     build: impl FnOnce(&Scene) -> Result<C, Failure>,
     report: &dyn Fn(&str, String),
+    board: &Board,
 ) -> anyhow::Result<()> {
     let run = opts.run.as_str();
     // The command subscription exists before the node registers, so the first command cannot be missed.
@@ -136,6 +153,7 @@ fn serve_session<C: NodeCore>(
     let scene_text = fetch_scene(session, run, Duration::from_millis(opts.timeout_ms))?;
     let scene = cosim_proto::scene::parse("(scene from the broker)", &scene_text, &[])?;
     let mut core = build(&scene)?;
+    board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
     let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
     session
         .put(key(run, topics.setup), setup)
@@ -145,6 +163,7 @@ fn serve_session<C: NodeCore>(
 
     let mut expected = 0u64;
     let mut t = 0.0;
+    let mut idle_since = std::time::Instant::now();
     loop {
         let Some(sample) = commands.recv_timeout(Duration::from_millis(200)).map_err(zerr)? else {
             while let Ok(Some(s)) = broker_alive.try_recv() {
@@ -167,10 +186,14 @@ fn serve_session<C: NodeCore>(
         };
         expected += 1;
         let dt = env.body.dt;
+        let computing = std::time::Instant::now();
+        let waited = (computing - idle_since).as_secs_f64();
         let Some(state) = core.handle(&env.body)? else {
             return Ok(());
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
+        board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
+        idle_since = std::time::Instant::now();
         state_pub
             .put(Envelope::new(run, env.step, t, state).encode())
             .wait()

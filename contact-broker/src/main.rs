@@ -10,8 +10,9 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use clap::Parser;
 use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
-use contact_broker::link::{FemLink, SphLink};
+use contact_broker::link::{FemLink, NodeLink, SphLink};
 use contact_broker::transport::{self, ZenohLink};
+use cosim_bus::status::{serve_status, Board};
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 
@@ -100,6 +101,13 @@ fn run(args: Args) -> anyhow::Result<()> {
         .liveliness()
         .declare_token(key(&args.run, topic::BROKER_ALIVE))
         .wait_ok()?;
+    // Live status (`cosim inspect`): the run's progress, what registered, how it ended.
+    let board = Board::new("contact-broker", &args.run);
+    let _status = serve_status(&session, key(&args.run, topic::BROKER_STATUS), board.clone())?;
+    board.update(|s| {
+        s.extra.insert("end_time".into(), scene.scene.run.end_time.into());
+        s.extra.insert("endpoints".into(), endpoints.clone().into());
+    });
     emit(serde_json::json!({"event": "listening", "endpoints": endpoints, "run": args.run}));
 
     let wait = Duration::from_secs_f64(args.wait_nodes);
@@ -112,6 +120,16 @@ fn run(args: Args) -> anyhow::Result<()> {
         Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
         None => None,
     };
+    board.update(|s| {
+        if let Some(f) = &fem {
+            s.counts.insert("fem_nodes".into(), f.setup().nodes.len() as u64);
+            s.counts.insert("fem_elements".into(), f.setup().cells.len() as u64);
+        }
+        if let Some(p) = &sph {
+            s.counts.insert("particles".into(), u64::from(p.setup().particles));
+        }
+        s.health = "running".into();
+    });
     let nodes = Nodes {
         fem: fem.as_mut().map(|l| l as &mut FemLink),
         sph: sph.as_mut().map(|l| l as &mut SphLink),
@@ -122,13 +140,44 @@ fn run(args: Args) -> anyhow::Result<()> {
         out: args.out.clone(),
     };
     let mut last = Instant::now();
+    let (mut last_t, mut last_step, mut last_wall) = (0.0, 0u64, Instant::now());
     let mut report = |p: Progress| {
+        // The broker's own time is not split from its wait for the nodes here: the summary has that split.
+        if p.step > last_step {
+            let dt = (p.t - last_t) / (p.step - last_step) as f64;
+            let wall = last_wall.elapsed().as_secs_f64() / (p.step - last_step) as f64;
+            board.update(|s| {
+                s.step = p.step;
+                s.t = p.t;
+                s.dt = dt;
+                s.extra.insert("wall_per_step".into(), wall.into());
+                s.extra.insert("progress".into(), (p.t / p.end_time).into());
+            });
+            (last_t, last_step, last_wall) = (p.t, p.step, Instant::now());
+        }
         if last.elapsed() >= Duration::from_millis(200) || p.t >= p.end_time {
             last = Instant::now();
             emit(serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time}));
         }
     };
     let outcome = coordinator::run(&scene, nodes, &info, &mut report);
+    board.update(|s| {
+        s.health = if outcome.summary.status == "ok" {
+            "finished"
+        } else {
+            "failed"
+        }
+        .into();
+        s.message = outcome.summary.message.clone();
+        s.extra.insert(
+            "contact_stats".into(),
+            serde_json::to_value(&outcome.summary.contact_stats).unwrap_or_default(),
+        );
+        s.extra.insert(
+            "timings".into(),
+            serde_json::to_value(&outcome.summary.timings).unwrap_or_default(),
+        );
+    });
     emit(serde_json::json!({"event": "done", "status": outcome.summary.status, "message": outcome.summary.message}));
     match outcome.error {
         Some(e) => Err(e),

@@ -22,6 +22,8 @@ pub enum Command {
     Check(CheckArgs),
     /// Draw one probe of several finished runs in one plot (and print its extremes per run).
     Compare(CompareArgs),
+    /// Show the live status of every process of a running run (a table that refreshes, or `--once` as JSON).
+    Inspect(InspectArgs),
     /// Run the benchmark suite: run time, memory and error of the validation scenes at several spacings, and
     /// cost per particle-step at four sizes (writes DIR/bench.json, DIR/report.md, DIR/pareto.svg).
     Bench(BenchArgs),
@@ -160,4 +162,27 @@ pub struct BenchRunArgs {
     /// File to write the process's peak resident memory and CPU time to (JSON).
     #[arg(long)]
     pub stats_out: PathBuf,
+}
+
+/// `cosim inspect`.
+#[derive(Args, Debug, Clone)]
+pub struct InspectArgs {
+    /// Run id (printed by `cosim run`, and in `DIR/summary.json`).
+    pub id: String,
+    /// Print one JSON document with every process's status and exit.
+    #[arg(long)]
+    pub once: bool,
+    /// Endpoint of the run (its broker's, or the router's) for a run on another host; a run on this machine is
+    /// found without it.
+    #[arg(long)]
+    pub connect: Option<String>,
+    /// `--connect` is a zenoh router: join through it as a client.
+    #[arg(long)]
+    pub client: bool,
+    /// Seconds to wait for the answers.
+    #[arg(long, default_value_t = 2.0)]
+    pub timeout: f64,
+    /// Seconds between refreshes of the table.
+    #[arg(long, default_value_t = 1.0)]
+    pub interval: f64,
 }

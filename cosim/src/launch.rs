@@ -202,6 +202,14 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             .cloned()
             .ok_or_else(|| anyhow::anyhow!("contact-broker listens on no TCP endpoint ({endpoints:?})"))?,
     };
+    // `cosim inspect ID` on this machine finds the run here while it lasts.
+    let _registered = crate::registry::register(&crate::registry::Entry {
+        run: info.run_id.clone(),
+        connect: connect.clone(),
+        client: args.connect.is_some(),
+        out: info.out.clone(),
+        pid: std::process::id(),
+    });
     if let Some(node) = args.external {
         let mode = if args.connect.is_some() { "client" } else { "peer" };
         announce_external(node, &info.run_id, &connect, mode, args.wait_external, &info.out)?;

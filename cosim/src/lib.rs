@@ -7,6 +7,8 @@ pub mod check;
 pub mod cli;
 pub mod compare;
 pub mod in_process;
+pub mod inspect;
 pub mod launch;
 pub mod progress;
+pub mod registry;
 pub mod run;

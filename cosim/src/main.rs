@@ -1,4 +1,4 @@
-//! `cosim`: run, check, compare, bench.
+//! `cosim`: run, check, compare, bench, inspect.
 
 use std::process::ExitCode;
 
@@ -7,7 +7,7 @@ use cosim::cli::{Cli, Command};
 
 fn main() -> ExitCode {
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn,zenoh=error".into()))
         .with_writer(std::io::stderr)
         .init();
     let cli = Cli::parse();
@@ -17,6 +17,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => cosim::compare::compare(&args),
         Command::Bench(args) => cosim::bench::bench(&args),
         Command::BenchRun(args) => cosim::bench::bench_run(&args),
+        Command::Inspect(args) => cosim::inspect::inspect(&args),
     };
     match result {
         Ok(code) => code,

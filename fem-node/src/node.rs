@@ -26,4 +26,13 @@ impl NodeCore for FemCore {
     fn handle(&mut self, cmd: &StepCommand) -> Result<Option<FemState>, Failure> {
         FemCore::handle(self, cmd).map_err(Failure::from)
     }
+
+    fn counts(&self) -> Vec<(&'static str, u64)> {
+        let m = self.mesh();
+        vec![
+            ("nodes", m.nodes.len() as u64),
+            ("elements", m.cells.len() as u64),
+            ("interface_segments", m.interface.len() as u64),
+        ]
+    }
 }

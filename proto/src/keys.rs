@@ -30,6 +30,10 @@ pub mod topic {
     pub const FEM_STATUS: &str = "fem/status";
     /// Status queryable of the broker.
     pub const BROKER_STATUS: &str = "broker/status";
+    /// Status queryable of the SPH node.
+    pub const SPH_STATUS: &str = "sph/status";
+    /// Every status queryable of a run (`cosim/<run>/*/status`).
+    pub const ANY_STATUS: &str = "*/status";
 }
 
 /// `cosim/<run>/<topic>`.
@@ -66,6 +70,8 @@ pub struct NodeTopics {
     pub command: &'static str,
     /// Liveliness token.
     pub alive: &'static str,
+    /// Live status queryable.
+    pub status: &'static str,
 }
 
 /// The structure node's topics.
@@ -76,6 +82,7 @@ pub const FEM: NodeTopics = NodeTopics {
     error: topic::FEM_ERROR,
     command: topic::BROKER_FEM,
     alive: topic::FEM_ALIVE,
+    status: topic::FEM_STATUS,
 };
 
 /// The fluid node's topics.
@@ -86,4 +93,5 @@ pub const SPH: NodeTopics = NodeTopics {
     error: topic::SPH_ERROR,
     command: topic::BROKER_SPH,
     alive: topic::SPH_ALIVE,
+    status: topic::SPH_STATUS,
 };

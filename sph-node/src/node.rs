@@ -26,4 +26,12 @@ impl NodeCore for SphCore {
     fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, Failure> {
         SphCore::handle(self, cmd).map_err(Failure::from)
     }
+
+    fn counts(&self) -> Vec<(&'static str, u64)> {
+        let s = SphCore::setup(self);
+        vec![
+            ("particles", u64::from(s.particles)),
+            ("wall_particles", s.walls.len() as u64),
+        ]
+    }
 }

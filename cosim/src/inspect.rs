@@ -1,0 +1,143 @@
+//! `cosim inspect ID [--once]`: the live status of every process of a run (`DESIGN.md` §5), from the
+//! `cosim/<ID>/*/status` queryables the broker and the nodes answer (`cosim_bus::status`).
+
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use cosim_bus::session::{open_client, open_listening};
+use cosim_bus::status::query_all;
+
+use crate::cli::InspectArgs;
+use crate::registry;
+
+/// One document: `{"run": ID, "nodes": {"contact-broker": {...}, "fem-node": {...}, "sph-node": {...}}}`.
+fn document(run: &str, answers: &[(String, String)]) -> serde_json::Value {
+    let mut nodes = serde_json::Map::new();
+    for (key, text) in answers {
+        let value: serde_json::Value =
+            serde_json::from_str(text).unwrap_or_else(|_| serde_json::json!({ "unreadable": text }));
+        let name = value
+            .get("node")
+            .and_then(|n| n.as_str())
+            .map(str::to_string)
+            .unwrap_or_else(|| key.clone());
+        nodes.insert(name, value);
+    }
+    serde_json::json!({ "run": run, "nodes": nodes })
+}
+
+fn number(v: &serde_json::Value, key: &str) -> f64 {
+    v.get(key).and_then(|x| x.as_f64()).unwrap_or(f64::NAN)
+}
+
+/// The table `cosim inspect` refreshes.
+fn table(doc: &serde_json::Value) -> String {
+    let mut out = format!(
+        "run {}\n{:<15} {:<9} {:>8} {:>10} {:>10} {:>12} {:>12}  {}\n",
+        doc["run"].as_str().unwrap_or("?"),
+        "process",
+        "health",
+        "step",
+        "t [s]",
+        "dt [s]",
+        "compute/step",
+        "wait/step",
+        "sizes"
+    );
+    if let Some(nodes) = doc["nodes"].as_object() {
+        for (name, s) in nodes {
+            let counts: Vec<String> = s["counts"]
+                .as_object()
+                .map(|c| c.iter().map(|(k, v)| format!("{k} {v}")).collect())
+                .unwrap_or_default();
+            out += &format!(
+                "{:<15} {:<9} {:>8} {:>10.5} {:>10.3e} {:>10.2} ms {:>9.2} ms  {}\n",
+                name,
+                s["health"].as_str().unwrap_or("?"),
+                s["step"].as_u64().unwrap_or(0),
+                number(s, "t"),
+                number(s, "dt"),
+                1e3 * number(s, "compute_per_step"),
+                1e3 * number(s, "waiting_per_step"),
+                counts.join(", ")
+            );
+            if let Some(stats) = s["extra"].get("contact_stats") {
+                out += &format!("{:<15} contact_stats {stats}\n", "");
+            }
+            if let Some(m) = s["message"].as_str().filter(|m| !m.is_empty()) {
+                out += &format!("{:<15} {m}\n", "");
+            }
+        }
+    }
+    out
+}
+
+/// Run `cosim inspect`; `Err` for bad input (exit 2).
+pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    let (connect, client) = match &args.connect {
+        Some(c) => (c.clone(), args.client),
+        None => match registry::lookup(&args.id) {
+            Some(e) => (e.connect, e.client || args.client),
+            None => anyhow::bail!(
+                "run `{}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
+                 elsewhere (in-process runs have no status to inspect)",
+                args.id,
+                registry::dir().display()
+            ),
+        },
+    };
+    let timeout_ms = (args.timeout * 1000.0) as u64;
+    let session = match client {
+        true => open_client(std::slice::from_ref(&connect), timeout_ms),
+        // Listening too: the nodes learn of the inspector through the broker (gossip) and connect to it, which is
+        // how their status reaches it (peers do not forward for each other). Zenoh gossips the addresses of a
+        // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for the inspector's few seconds only).
+        false => open_listening(&["tcp/0.0.0.0:0".to_string()], std::slice::from_ref(&connect), timeout_ms)
+            .map(|(s, _)| s),
+    }
+    .map_err(|e| anyhow::anyhow!("cannot reach run `{}` at {connect}: {e:#}", args.id))?;
+    // Let zenoh learn the run's queryables (gossip) before the first question.
+    std::thread::sleep(Duration::from_millis(1500));
+    let timeout = Duration::from_secs_f64(args.timeout);
+    if args.once {
+        let answers = query_all(&session, &args.id, timeout)?;
+        if answers.is_empty() {
+            eprintln!("cosim: no process of run `{}` answered at {connect}", args.id);
+            return Ok(ExitCode::from(1));
+        }
+        println!("{:#}", document(&args.id, &answers));
+        return Ok(ExitCode::SUCCESS);
+    }
+    let terminal = std::io::stdout().is_terminal();
+    let mut silent_since: Option<Instant> = None;
+    loop {
+        let answers = query_all(&session, &args.id, timeout)?;
+        let doc = document(&args.id, &answers);
+        let mut out = std::io::stdout().lock();
+        if terminal {
+            let _ = write!(out, "\x1b[2J\x1b[H");
+        }
+        let _ = writeln!(out, "{}", table(&doc));
+        let _ = out.flush();
+        drop(out);
+        let done = doc["nodes"].as_object().is_some_and(|n| {
+            !n.is_empty()
+                && n.values()
+                    .all(|s| s["health"] != "running" && s["health"] != "starting")
+        });
+        if done {
+            return Ok(ExitCode::SUCCESS);
+        }
+        if answers.is_empty() {
+            let since = *silent_since.get_or_insert_with(Instant::now);
+            if since.elapsed() > Duration::from_secs(3) {
+                eprintln!("cosim: run `{}` no longer answers (finished or gone)", args.id);
+                return Ok(ExitCode::SUCCESS);
+            }
+        } else {
+            silent_since = None;
+        }
+        std::thread::sleep(Duration::from_secs_f64(args.interval));
+    }
+}

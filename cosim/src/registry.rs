@@ -1,0 +1,64 @@
+//! Where `cosim inspect ID` finds a run started on this machine: `cosim run` (processes mode) writes
+//! `$TMPDIR/cosim-runs/<ID>.json` with the endpoint to join once the broker listens, and removes it when the run
+//! ends. A run on another host is inspected with `--connect` instead.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// How to join a running run.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Entry {
+    /// Run id.
+    pub run: String,
+    /// Endpoint to connect to: the broker's, or the router's.
+    pub connect: String,
+    /// Join as a zenoh client (the run goes through a router).
+    pub client: bool,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Process id of `cosim run`.
+    pub pid: u32,
+}
+
+/// The folder of the entries.
+pub fn dir() -> PathBuf {
+    std::env::temp_dir().join("cosim-runs")
+}
+
+fn path(run: &str) -> PathBuf {
+    dir().join(format!("{run}.json"))
+}
+
+/// An entry on disk, removed when dropped.
+pub struct Registration(PathBuf);
+
+impl Drop for Registration {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// Write the entry (best effort: a run that cannot register still runs; it is then inspected with `--connect`).
+pub fn register(entry: &Entry) -> Option<Registration> {
+    let file = path(&entry.run);
+    let write = || -> std::io::Result<()> {
+        std::fs::create_dir_all(dir())?;
+        let tmp = file.with_extension("json.tmp");
+        std::fs::write(&tmp, serde_json::to_vec_pretty(entry)?)?;
+        std::fs::rename(&tmp, &file)
+    };
+    match write() {
+        Ok(()) => Some(Registration(file)),
+        Err(e) => {
+            tracing::debug!("cannot register run {} in {}: {e}", entry.run, dir().display());
+            None
+        }
+    }
+}
+
+/// The entry of `run`, if one is registered and its `cosim run` is still alive.
+pub fn lookup(run: &str) -> Option<Entry> {
+    let entry: Entry = serde_json::from_slice(&std::fs::read(path(run)).ok()?).ok()?;
+    Path::new(&format!("/proc/{}", entry.pid)).exists().then_some(entry)
+}

@@ -1,0 +1,145 @@
+//! Live inspection (`DESIGN.md` §5): while a coupled run goes on as three processes, `cosim inspect ID --once`
+//! from another process prints one JSON document with the status of the broker and both nodes (found through
+//! the local run registry, or with `--connect` to the run's endpoint as from another host); the refreshing table
+//! follows the run and ends when the run does; a run that is not going is refused.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::*;
+
+const LIMIT: Duration = Duration::from_secs(120);
+
+/// Kills the child when dropped.
+struct Kill(Child);
+
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// The coarse gate as processes, not waited for.
+fn start(out: &Path, id: &str, end_time: &str) -> Kill {
+    Kill(
+        Command::new(cosim())
+            .current_dir(root())
+            .env("COSIM_BIN_DIR", bin_dir())
+            .args(["run", "scenes/elastic_gate.toml", "--quiet", "--run-id", id, "--out"])
+            .arg(out)
+            .args([
+                "--set",
+                "fluid.spacing=0.004",
+                "--set",
+                &format!("run.end_time={end_time}"),
+            ])
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    )
+}
+
+fn samples(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().skip(1).count())
+}
+
+fn inspect(args: &[&str]) -> (i32, serde_json::Value, String) {
+    let mut all = vec!["inspect"];
+    all.extend_from_slice(args);
+    let out = cosim_run(&all, Duration::from_secs(30));
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let doc = serde_json::from_str(&stdout).unwrap_or(serde_json::Value::Null);
+    (
+        out.status.code().unwrap_or(-1),
+        doc,
+        String::from_utf8_lossy(&out.stderr).into_owned() + &stdout,
+    )
+}
+
+fn check_document(doc: &serde_json::Value, id: &str) {
+    assert_eq!(doc["run"], id);
+    let nodes = doc["nodes"].as_object().unwrap_or_else(|| panic!("{doc:#}"));
+    assert_eq!(nodes.len(), 3, "broker and both nodes answer: {doc:#}");
+    for name in ["contact-broker", "fem-node", "sph-node"] {
+        let s = &nodes[name];
+        assert_eq!(s["health"], "running", "{name}: {s}");
+        assert_eq!(s["run"], id);
+        assert!(s["step"].as_u64().unwrap() > 0, "{name}: {s}");
+        assert!(s["t"].as_f64().unwrap() > 0.0, "{name}: {s}");
+        assert!(s["dt"].as_f64().unwrap() > 0.0, "{name}: {s}");
+        assert!(s["wall_seconds"].as_f64().unwrap() > 0.0, "{name}: {s}");
+        assert!(s["pid"].as_u64().unwrap() > 0, "{name}: {s}");
+    }
+    // Sizes as the scene makes them: 875 particles at 4 mm, the gate's 5 × 79 quad4 mesh.
+    assert_eq!(nodes["sph-node"]["counts"]["particles"], 875);
+    assert_eq!(nodes["fem-node"]["counts"]["nodes"], 480);
+    assert_eq!(nodes["fem-node"]["counts"]["elements"], 395);
+    assert_eq!(nodes["contact-broker"]["counts"]["particles"], 875);
+    // The nodes split their wall time into compute and waiting.
+    for name in ["fem-node", "sph-node"] {
+        assert!(nodes[name]["compute_per_step"].as_f64().unwrap() > 0.0);
+        assert!(nodes[name]["waiting_per_step"].as_f64().unwrap() >= 0.0);
+    }
+}
+
+#[test]
+fn inspect_a_running_coupled_run() {
+    let dir = scratch("inspect");
+    let out = dir.join("out");
+    let id = run_id("inspect");
+    let mut run = start(&out, &id, "10");
+    let started = Instant::now();
+    while samples(&out) < 3 {
+        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
+        assert!(started.elapsed() < LIMIT, "the run did not get going");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // Found on this machine by its id.
+    let (code, doc, text) = inspect(&[&id, "--once"]);
+    assert_eq!(code, 0, "{text}");
+    check_document(&doc, &id);
+    // As from another host: given the endpoint.
+    let entry = json(&std::env::temp_dir().join("cosim-runs").join(format!("{id}.json")));
+    let endpoint = entry["connect"].as_str().unwrap().to_string();
+    let (code, doc, text) = inspect(&[&id, "--once", "--connect", &endpoint]);
+    assert_eq!(code, 0, "{text}");
+    check_document(&doc, &id);
+    drop(run);
+    // Gone: refused, naming the run.
+    let (code, _, text) = inspect(&["no-such-run", "--once"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("no-such-run"), "{text}");
+}
+
+#[test]
+fn the_table_follows_a_run_to_its_end() {
+    let dir = scratch("inspect-live");
+    let out = dir.join("out");
+    let id = run_id("inspect-live");
+    let mut run = start(&out, &id, "0.25");
+    let started = Instant::now();
+    while samples(&out) < 2 {
+        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
+        assert!(started.elapsed() < LIMIT, "the run did not get going");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let table = cosim_run(&["inspect", &id, "--interval", "0.2"], LIMIT);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(
+        table.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&table.stderr)
+    );
+    for name in ["contact-broker", "fem-node", "sph-node"] {
+        assert!(text.contains(name), "{name} not in the table: {text}");
+    }
+    // It stopped because the run did: the run is over by now.
+    let status = run.0.wait().unwrap();
+    assert!(status.success());
+}
