@@ -8,12 +8,15 @@
 //! * [`contact`]: the particles against a structure the fluid does not see (coupled runs): Neumann rows, not a free
 //!   surface.
 //! * [`wall_guard`]: a particle found inside a wall is put back on its face.
+//! * [`wall_normal`]: the projection's wall condition u^{n+1} · n = 0 in the wall rows and the walls' velocity in
+//!   ∇·u*.
 //! * [`solver`]: [`IsphSolver`], with the public API of [`crate::WcsphSolver`].
 //!
 //! Walls are PPE unknowns: each wall particle has the row of the Adami et al. 2012 extrapolation, Eq. (27),
-//! p_w − Σ_f p_f W_wf / Σ_f W_wf = g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf, a discrete Neumann condition
-//! ∂p/∂n = ρ g · n, so the hydrostatic pressure is right at the wall. In ∇·u* the walls carry Δt g (the
-//! predictor applied to them), so the gravity flux into the wall is imposed once, by the Neumann rows.
+//! p_w − Σ_f p_f W_wf / Σ_f W_wf = g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf + the fluid's normal motion, a discrete Neumann
+//! condition ∂p/∂n = ρ u* · n/Δt ([`wall_normal`]), so the hydrostatic pressure is right at the wall and the
+//! corrected velocity does not enter it. In ∇·u* the walls carry Δt g (the predictor applied to them) plus the
+//! normal part of the fluid's motion next to them, so the flux into the wall is imposed once, by the Neumann rows.
 //! After the solve negative pressures are clipped to 0 (fluid and walls).
 
 pub mod bicgstab;
@@ -23,6 +26,7 @@ pub mod ppe;
 pub mod projection;
 pub mod solver;
 pub mod wall_guard;
+pub mod wall_normal;
 
 pub use solver::IsphSolver;
 

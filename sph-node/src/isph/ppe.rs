@@ -8,10 +8,13 @@
 //!   diagonal Σ_j c_ij is positive: c_i p_i − Σ_j c_ij p_j = −source_i.
 //! * Free-surface fluid particle (∇·r < threshold): p_i = 0 (Dirichlet).
 //! * Wall particle w (Adami et al. 2012, Eq. (27), a_w = 0): p_w − Σ_f (W_wf/Σ_f W_wf) p_f =
-//!   g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf; a wall particle with no fluid in reach gets p_w = 0.
+//!   Σ_f [ρ_f g · r_wf + ρ_f (ũ_f · n)(r_wf · n)/Δt] W_wf / Σ_f W_wf, ũ_f = u*_f − Δt g, n the wall's normal: the
+//!   projection's condition u^{n+1} · n = 0 ([`super::wall_normal`]); a wall particle with no fluid in reach gets
+//!   p_w = 0.
 
 use rayon::prelude::*;
 
+use super::wall_normal;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{separation, ParticleView};
@@ -214,17 +217,22 @@ pub fn fluid_row(
     (row, rhs)
 }
 
-/// Row of wall particle w (a `view` index ≥ `n_fluid`) and its right-hand side: Adami et al. 2012, Eq. (27).
+/// Row of wall particle w (a `view` index ≥ `n_fluid`) and its right-hand side: Adami et al. 2012, Eq. (27), with
+/// the normal motion of the fluid ([`super::wall_normal`]; `view.v` holds u* of the fluid, `normal` is w's normal,
+/// `dt` the step).
+#[allow(clippy::too_many_arguments)]
 pub fn wall_row(
     w: usize,
     view: &ParticleView<'_>,
     neighbors: &[u32],
     kernel: &CubicSpline,
     gravity: [f64; 2],
+    normal: [f64; 2],
+    dt: f64,
 ) -> (Vec<(u32, f64)>, f64) {
     let xw = view.x[w];
     let mut row = vec![(w as u32, 1.0)];
-    let (mut sum_w, mut sum_rho_r) = (0.0, [0.0, 0.0]);
+    let (mut sum_w, mut sum_rho_r, mut sum_motion) = (0.0, [0.0, 0.0], 0.0);
     for &f in neighbors {
         let f = f as usize;
         if f >= view.n_fluid {
@@ -235,6 +243,7 @@ pub fn wall_row(
         sum_w += wgt;
         sum_rho_r[0] += view.rho[f] * r_wf[0] * wgt;
         sum_rho_r[1] += view.rho[f] * r_wf[1] * wgt;
+        sum_motion += wall_normal::normal_motion_term(view.rho[f], view.v[f], r_wf, normal, dt, gravity) * wgt;
         row.push((f as u32, wgt));
     }
     if sum_w <= 0.0 {
@@ -244,13 +253,16 @@ pub fn wall_row(
         // Adami et al. 2012, Eq. (27): p_w = Σ_f p_f W_wf / Σ_f W_wf + …
         e.1 = -e.1 / sum_w;
     }
-    // Adami et al. 2012, Eq. (27), a_w = 0: … + g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf
-    let rhs = (gravity[0] * sum_rho_r[0] + gravity[1] * sum_rho_r[1]) / sum_w;
+    // Adami et al. 2012, Eq. (27), a_w = 0: … + g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf; + the normal motion stopped by the
+    // projection (Cummins & Rudman 1999: ∂p/∂n = ρ u*·n/Δt), `wall_normal`
+    let rhs = (gravity[0] * sum_rho_r[0] + gravity[1] * sum_rho_r[1] + sum_motion) / sum_w;
     (row, rhs)
 }
 
-/// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags) and `contact`
-/// (particles against a structure, see [`fluid_row`]; empty for none) in, the matrix and right-hand side out.
+/// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags), `contact`
+/// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` (one per wall particle,
+/// see [`super::wall_normal`]) and the step `dt` in, the matrix and right-hand side out. `view.v` holds u* of the
+/// fluid.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble(
     view: &ParticleView<'_>,
@@ -261,6 +273,8 @@ pub fn assemble(
     free: &[bool],
     contact: &[bool],
     sources: &[f64],
+    normals: &[[f64; 2]],
+    dt: f64,
 ) -> (SparseRows, Vec<f64>) {
     let rows: Vec<(Vec<(u32, f64)>, f64)> = (0..view.x.len())
         .into_par_iter()
@@ -269,7 +283,8 @@ pub fn assemble(
                 let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
                 fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic)
             } else {
-                wall_row(i, view, list.of(i), kernel, gravity)
+                let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
+                wall_row(i, view, list.of(i), kernel, gravity, normal, dt)
             }
         })
         .collect();

@@ -35,11 +35,11 @@ pub fn viscous_acceleration(
 
 /// ∇·u_i = (1/ρ_i) Σ_j m_j (u_j − u_i) · ∇_i W_ij over fluid and wall neighbours (Cummins & Rudman 1999).
 ///
-/// The caller gives the wall particles the velocity Δt g in `view.v` (the predictor applied to the walls as
-/// well): the gravity part of u* against the wall is then left to the Neumann condition of the wall rows
-/// (Adami et al. 2012, Eq. (27): ∂p/∂n = ρ g · n), and the divergence sees only the actual motion towards or away
-/// from the wall, u*_i − Δt g = uⁿ_i + Δt ν∇²uⁿ_i. Without the walls a particle moving into a wall would see an
-/// expansion and be sucked in; with walls at rest the gravity flux would be imposed twice.
+/// The caller gives the wall particles the velocity Δt g + (ũ_w · n) n in `view.v` (the predictor applied to the
+/// walls as well, and the normal part of the fluid's motion next to them; [`super::wall_normal`]): the flux of u*
+/// into the wall is then left to the Neumann condition of the wall rows (∂p/∂n = ρ u* · n/Δt), and the divergence
+/// sees only the motion along the wall. Without the walls a particle moving into a wall would see an expansion and
+/// be sucked in; with walls at rest the flux would be imposed twice.
 #[inline]
 pub fn velocity_divergence(i: usize, view: &ParticleView<'_>, neighbors: &[u32], kernel: &CubicSpline) -> f64 {
     let (xi, vi) = (view.x[i], view.v[i]);

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::contact::{self, ContactLayer, ContactRow};
 use super::wall_guard::WallBoxes;
-use super::{bicgstab, free_surface, ppe, projection, IsphOptions, PpeSource};
+use super::{bicgstab, free_surface, ppe, projection, wall_normal, IsphOptions, PpeSource};
 use crate::boundary::walls;
 use crate::corrections::xsph;
 use crate::eos::Tait;
@@ -42,6 +42,7 @@ struct Scratch {
     in_contact: Vec<bool>,
     source: Vec<f64>,
     xsph: Vec<[f64; 2]>,
+    wall_v: Vec<[f64; 2]>,
 }
 
 /// What the last PPE solve did.
@@ -85,6 +86,8 @@ pub struct IsphSolver {
     contact: ContactLayer,
     /// The wall boxes, to put back a particle found inside a wall (see [`super::wall_guard`]).
     wall_boxes: WallBoxes,
+    /// The unit normal of each wall particle ([`super::wall_normal`]).
+    wall_normals: Vec<[f64; 2]>,
     scratch: Scratch,
 }
 
@@ -146,6 +149,7 @@ impl IsphSolver {
         };
         let wall_x = walls::wall_positions(&scene.walls, spec.blocks[0].min, dx, h, fluid_centre);
         let wall_boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
+        let wall_normals = wall_normal::wall_normals(&wall_x, &wall_boxes);
         let nw = wall_x.len();
         let walls = WallParticles {
             x: wall_x,
@@ -206,6 +210,7 @@ impl IsphSolver {
             last_ppe: PpeReport::default(),
             contact: ContactLayer::default(),
             wall_boxes,
+            wall_normals,
             scratch: Scratch::default(),
         };
         solver.contact.record_end(&solver.state);
@@ -379,11 +384,21 @@ impl IsphSolver {
         let n_contact = in_contact.iter().filter(|&&c| c).count();
         let mut source = std::mem::take(&mut self.scratch.source);
         source.clear();
-        // Walls carry Δt g for the divergence only (see `projection::velocity_divergence`), and so does the normal
-        // velocity of the first layer against a structure, with the face's (see `contact::face_normal_velocity`).
-        for v in &mut self.scratch.v[nf..] {
-            *v = [dt * g[0], dt * g[1]];
-        }
+        // Walls carry Δt g and the normal part of the fluid's motion next to them for the divergence only (see
+        // `projection::velocity_divergence` and `wall_normal`), and so does the normal velocity of the first layer
+        // against a structure, with the face's (see `contact::face_normal_velocity`).
+        let mut wall_v = std::mem::take(&mut self.scratch.wall_v);
+        wall_normal::divergence_velocities_into(
+            &self.view(),
+            &self.scratch.list,
+            &self.kernel,
+            &self.wall_normals,
+            dt,
+            g,
+            &mut wall_v,
+        );
+        self.scratch.v[nf..].copy_from_slice(&wall_v);
+        self.scratch.wall_v = wall_v;
         for (v, row) in self.scratch.v[..nf].iter_mut().zip(&rows) {
             if let Some(row) = row.filter(|r| r.against) {
                 *v = contact::face_normal_velocity(*v, &row.face, dt, g);
@@ -449,6 +464,8 @@ impl IsphSolver {
             &free,
             &in_contact,
             &source,
+            &self.wall_normals,
+            dt,
         );
         let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
         let inv_diag: Vec<f64> = a

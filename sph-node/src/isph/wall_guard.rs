@@ -62,6 +62,18 @@ impl WallBoxes {
             .any(|(lo, hi)| (0..2).all(|k| x[k] > lo[k] && x[k] < hi[k]))
     }
 
+    /// The unit direction from `x` to the nearest point outside every box (the normal of the wall face nearest to a
+    /// point inside a wall; diagonal in a corner where boxes meet); `None` outside the walls.
+    pub fn exit_direction(&self, x: [f64; 2]) -> Option<[f64; 2]> {
+        let (mut y, mut v) = (x, [0.0; 2]);
+        if !self.push_out(&mut y, &mut v) {
+            return None;
+        }
+        let d = [y[0] - x[0], y[1] - x[1]];
+        let n = d[0].hypot(d[1]);
+        (n > 0.0).then(|| [d[0] / n, d[1] / n])
+    }
+
     /// Moves a particle strictly inside a wall box to the nearest point outside every box whose coordinates are
     /// its own or those of box faces (just outside them: a face, or a corner where boxes meet), and removes the
     /// part of its velocity into the wall along each coordinate that changed. Returns whether it was moved.
