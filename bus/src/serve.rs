@@ -99,7 +99,7 @@ pub fn serve<C: NodeCore>(
         };
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
     };
-    let result = serve_session(&session, opts, topics, build, &report, &board);
+    let result = serve_session(&session, opts, topics, build, &board);
     board.update(|s| {
         s.health = if result.is_ok() { "finished" } else { "failed" }.into();
         if let Err(e) = &result {
@@ -123,7 +123,6 @@ fn serve_session<C: NodeCore>(
     opts: &NodeOptions,
     topics: NodeTopics,
     build: impl FnOnce(&Scene) -> Result<C, Failure>,
-    report: &dyn Fn(&str, String),
     board: &Board,
 ) -> anyhow::Result<()> {
     let run = opts.run.as_str();
@@ -178,9 +177,16 @@ fn serve_session<C: NodeCore>(
         {
             Ok(env) => env,
             Err(e) => {
-                // Refused, never applied: say so and keep the state as it is.
-                tracing::error!("{e}");
-                report("failed", format!("refused a command: {e}"));
+                // Refused, never applied (`docs/PROTOCOL.md` §7): logged, counted on the status, and the node
+                // keeps its state and waits for the command it expects. Not reported as a failure: a stray
+                // message must not end the run; a broker whose commands this node cannot read times out on it
+                // and says so.
+                tracing::error!("refused a command: {e}");
+                board.update(|s| {
+                    let n = s.extra.get("refused").and_then(|v| v.as_u64()).unwrap_or(0) + 1;
+                    s.extra.insert("refused".into(), n.into());
+                    s.extra.insert("last_refused".into(), e.to_string().into());
+                });
                 continue;
             }
         };

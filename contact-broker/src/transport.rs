@@ -3,7 +3,6 @@
 
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
 use cosim_proto::envelope::{CodecError, Envelope};
 use cosim_proto::keys::{key, topic, NodeTopics};
 use cosim_proto::messages::{NodeError, StepCommand};
@@ -78,22 +77,24 @@ pub struct ZenohLink<S, T> {
     _state: std::marker::PhantomData<T>,
 }
 
-/// Turn an error sample into the error the run ends with.
-fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> LinkError {
+/// Turn an error sample into the error the run ends with; `None` for a message that does not decode as this
+/// run's error report (logged and dropped: a stray message must not end the run; a node that really fails also
+/// exits, and its liveliness token says so).
+fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkError> {
     let node = topics.name.to_string();
     match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, topics.error) {
-        Ok(env) if env.body.status == "unstable" => LinkError::Unstable {
+        Ok(env) if env.body.status == "unstable" => Some(LinkError::Unstable {
             node,
             message: env.body.message,
-        },
-        Ok(env) => LinkError::Failed {
+        }),
+        Ok(env) => Some(LinkError::Failed {
             node,
             message: env.body.message,
-        },
-        Err(e) => LinkError::Failed {
-            node,
-            message: format!("sent an undecodable error report: {e}"),
-        },
+        }),
+        Err(e) => {
+            tracing::error!("{node}: refused an error report: {e}");
+            None
+        }
     }
 }
 
@@ -113,16 +114,29 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
                 .setup
                 .recv_timeout(Duration::from_millis(50))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
+            // A registration that does not decode as this run's is refused: logged, and the wait goes on.
+            let mut refused = None;
             if let Some(sample) = got {
-                let env = Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup)
-                    .with_context(|| format!("{} registration refused", topics.name))?;
-                break env.body;
+                match Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup) {
+                    Ok(env) => break env.body,
+                    Err(e) => {
+                        tracing::error!("{}: refused a registration: {e}", topics.name);
+                        refused = Some(e.to_string());
+                    }
+                }
             }
             if let Some(sample) = subs.error.try_recv().map_err(|e| anyhow::anyhow!("{e}"))? {
-                return Err(node_error(&sample, run, &topics).into());
+                if let Some(e) = node_error(&sample, run, &topics) {
+                    return Err(e.into());
+                }
             }
             if Instant::now() > deadline {
-                anyhow::bail!("{}: did not register within {:.0} s", topics.name, wait.as_secs_f64());
+                let why = refused.map(|r| format!(" (refused: {r})")).unwrap_or_default();
+                anyhow::bail!(
+                    "{}: did not register within {:.0} s{why}",
+                    topics.name,
+                    wait.as_secs_f64()
+                );
             }
         };
         let command = session
@@ -153,14 +167,18 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
 
     /// A failure the node reported or its death, if either happened.
     fn check_node(&self) -> Result<(), LinkError> {
-        if let Ok(Some(sample)) = self.error.try_recv() {
-            return Err(node_error(&sample, &self.run, &self.topics));
+        while let Ok(Some(sample)) = self.error.try_recv() {
+            if let Some(e) = node_error(&sample, &self.run, &self.topics) {
+                return Err(e);
+            }
         }
         while let Ok(Some(sample)) = self.alive.try_recv() {
             if sample.kind() == SampleKind::Delete {
                 // It may have reported why just before it went.
                 if let Ok(Some(sample)) = self.error.recv_timeout(Duration::from_millis(200)) {
-                    return Err(node_error(&sample, &self.run, &self.topics));
+                    if let Some(e) = node_error(&sample, &self.run, &self.topics) {
+                        return Err(e);
+                    }
                 }
                 return Err(self.failed("the node died (its liveliness token disappeared)"));
             }
@@ -187,21 +205,31 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn receive(&mut self, step: u64) -> Result<T, LinkError> {
         let deadline = Instant::now() + self.step_timeout;
+        // A message that is not this run's answer to this step (malformed, another version, run or step) is
+        // refused: logged, never applied, and the wait goes on (`docs/PROTOCOL.md` §7).
+        let mut refused: Option<String> = None;
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
-                    let env = Envelope::<T>::decode(&sample.payload().to_bytes(), &self.run, self.topics.state)
+                    match Envelope::<T>::decode(&sample.payload().to_bytes(), &self.run, self.topics.state)
                         .and_then(|e| e.expect_step(step, self.topics.state))
-                        .map_err(|e: CodecError| self.failed(format!("refused its state: {e}")))?;
-                    return Ok(env.body);
+                    {
+                        Ok(env) => return Ok(env.body),
+                        Err(e) => {
+                            let e: CodecError = e;
+                            tracing::error!("{}: refused a state message: {e}", self.topics.name);
+                            refused = Some(e.to_string());
+                        }
+                    }
                 }
                 Ok(None) => {}
                 Err(e) => return Err(self.failed(format!("state channel closed: {e}"))),
             }
             self.check_node()?;
             if Instant::now() > deadline {
+                let why = refused.map(|r| format!("; refused instead: {r}")).unwrap_or_default();
                 return Err(self.failed(format!(
-                    "no answer to step {step} within {:.0} s (coupling.step_timeout)",
+                    "no answer to step {step} within {:.0} s (coupling.step_timeout){why}",
                     self.step_timeout.as_secs_f64()
                 )));
             }
