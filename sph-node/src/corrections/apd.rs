@@ -1,29 +1,38 @@
-//! Artificial particle displacement, APD (`DESIGN.md` §4.4; Xu, Stansby & Laurence 2009, J. Comput. Phys.
-//! 228:6703, Eq. (35); Shadloo, Zainali, Yildiz & Suleman 2012, Int. J. Numer. Meth. Eng. 89:939, Eq. (37)):
+//! Artificial particle displacement, APD (`DESIGN.md` §4.4), in the kernel-gradient ("Fickian") form of the
+//! δ+-SPH particle shifting (Sun, Colagrossi, Marrone & Zhang 2017, Comput. Methods Appl. Mech. Eng. 315:25,
+//! Eq. (7); the Fickian shift of Lind, Xu, Stansby & Rogers 2012, J. Comput. Phys. 231:1499):
 //!
-//! δr_i = β r̄_i² v_max Δt Σ_j r_ij / |r_ij|³,
+//! δr_i = −K β h v_max Δt Σ_j [1 + R (W_ij / W(Δx_i))⁴] V_j ∇_i W_ij,   K = [`K_SUN`], R = [`R_PAIRING`],
 //!
-//! with r̄_i the mean distance to the neighbours of i, v_max the largest fluid speed and Δt the step. The sum runs
-//! over every neighbour within the support 2h, wall particles included (so the shift also pushes fluid away from
-//! the walls). |δr_i| is capped at [`SHIFT_CAP`]·h.
+//! with V_j = m_j/ρ_j, v_max the largest fluid speed, Δt the step and Δx_i = sqrt(V_i) the local spacing. The sum
+//! runs over every neighbour within 2h, wall particles included (they hold the fluid off the walls as the
+//! ghost particles of Sun et al. do). β keeps the meaning of Xu, Stansby & Laurence 2009 (J. Comput. Phys.
+//! 228:6703, Eq. (35), δr_i = β r̄_i² v_max Δt Σ_j r_ij/|r_ij|³, the form this module had before): the shift per
+//! step is β times a velocity-times-step scale, and β = 0.04 gives K β = 2, half of Sun et al.'s CFL·Ma·(2h)²/h
+//! = 4 v_max Δt. The kernel-gradient form goes to zero smoothly at 2h and stays finite for close pairs (Xu's sum
+//! grows as 1/|r_ij|² and stops abruptly at 2h); the anti-pairing term R (W_ij/W(Δx))⁴ (Sun et al., after
+//! Monaghan 2000) pushes close pairs apart. |δr_i| is capped at [`SHIFT_CAP`]·h.
 //!
-//! Free surface: a particle with ∇·r_i = −Σ_j (m_j/ρ_j) r_ij·∇_i W_ij < [`FREE_SURFACE_DIV_R`] (2D; about 2 inside
-//! the fluid, about 1 on a flat surface; Lee et al. 2008 / Lind et al. 2012 criterion) is taken as a free-surface
-//! particle and is not shifted (`DESIGN.md` §4.4: "no shift").
+//! Free surface (`DESIGN.md` §4.4; the free-surface treatment of the shift in Sun et al. 2017 and Lind et al.
+//! 2012): a particle with ∇·r_i = −Σ_j V_j r_ij·∇_i W_ij < [`FREE_SURFACE_DIV_R`] (2D; about 2 inside the fluid,
+//! about 1 on a flat surface) is a free-surface particle and is not shifted; a particle with ∇·r_i <
+//! [`NEAR_SURFACE_DIV_R`] keeps only the part of its shift tangential to the surface, whose normal is
+//! −Σ_{j fluid} V_j ∇_i W_ij normalised (fluid neighbours only, so that a dry wall above the water does not tilt
+//! it).
 //!
-//! Hydrodynamic quantities: no Taylor correction of v or ρ; instead the density is changed as the continuity
-//! equation would change it for the displacement δr ([`shift_density_change`]), keeping ρ consistent with the
-//! particle number density.
+//! Hydrodynamic quantities: no Taylor correction of v or ρ; the density is changed as the continuity equation
+//! would change it for the displacement δr ([`shift_density_change`]), keeping ρ consistent with the particle
+//! number density (the Taylor form δr·∇ρ and the ALE form of Sun et al. 2019 were tried; see
+//! `docs/CORRECTIONS.md`).
 //!
 //! Still water (why the scene default of β is 0; numbers in `docs/CORRECTIONS.md`): the WCSPH square lattice
-//! pairs up under hydrostatic load with or without APD (cubic spline, h = 1.3Δx, α = 0.01). With the v_max Δt
-//! scale the shift is about 100 times weaker in still water (v_max of a few cm/s) than in a dam break and does
-//! not stop the pairing; once pairs exist it pushes the partners apart every step while the pressure holds them
-//! together, and that exchange feeds the noise (β = 0.04: 8 % r.m.s. particle pressure noise mid-depth, six
-//! times the kinetic energy of β = 0, unstable before t = 9 s). A shift strong enough to keep the lattice
-//! ordered (a velocity scale of sqrt(g H)) does stop the pairing, but the shift moves particles without
-//! changing their velocity, so wherever its fixed point and the pressure balance differ (walls, corners) the
-//! particles keep a velocity equal to the shift rate, which grows until the run blows up (≈ 5 s).
+//! pairs up under hydrostatic load with or without APD (cubic spline, h = 1.3Δx, α = 0.01), and the paired
+//! lattice is the stable equilibrium of the SPH forces. A shift that pushes the pairs apart works against those
+//! forces every step (with the continuity-form ρ update the shift changes the potential energy by
+//! −Σ m_i a_i·δr_i), and the energy it puts in grows: with R = 0.2 and β = 0.04 the still tank ends 10 s with
+//! pressure errors near −10 % and kinetic energy 3 times the test's bound. A weaker anti-pairing term (R = 0.05)
+//! passes the 10 s coarse tank but not the 2 s one (+3.0 % at mid-depth); a velocity scale that does not vanish
+//! in still water (c0/10) blows up, as with Xu's form.
 
 use rayon::prelude::*;
 
@@ -34,13 +43,22 @@ use crate::particles::{dot, separation, ParticleView};
 /// ∇·r below which a particle is a free-surface particle (2D).
 pub const FREE_SURFACE_DIV_R: f64 = 1.5;
 
+/// ∇·r below which a particle is near the free surface and keeps only the tangential part of its shift (2D).
+pub const NEAR_SURFACE_DIV_R: f64 = 1.8;
+
+/// K of the shift: β = 0.04 gives K β = 2 (see the module documentation).
+pub const K_SUN: f64 = 50.0;
+
+/// R of the anti-pairing term (Sun et al. 2017, below Eq. (9): R = 0.2, exponent n = 4).
+pub const R_PAIRING: f64 = 0.2;
+
 /// Largest shift, as a fraction of h (`DESIGN.md` §4.4).
 pub const SHIFT_CAP: f64 = 0.05;
 
 /// Parameters of one APD pass.
 #[derive(Clone, Copy, Debug)]
 pub struct ApdParams {
-    /// β (Xu et al. 2009 use 0.01–0.1).
+    /// β (Xu et al. 2009 use 0.01–0.1; 0.04 is the paper's).
     pub beta: f64,
     /// Largest fluid speed v_max.
     pub v_max: f64,
@@ -71,33 +89,47 @@ pub fn apd_shift(
     kernel: &CubicSpline,
     p: &ApdParams,
 ) -> [f64; 2] {
-    if position_divergence(i, view, neighbors, kernel) < FREE_SURFACE_DIV_R {
+    let xi = view.x[i];
+    // Sun et al. 2017, Eq. (7): W(Δx), here at the local spacing Δx_i = sqrt(m_i/ρ_i)
+    let w_dx = kernel.w((view.m[i] / view.rho[i]).sqrt());
+    let (mut div_r, mut s, mut fluid) = (0.0, [0.0, 0.0], [0.0, 0.0]);
+    for &j in neighbors {
+        let j = j as usize;
+        let (r_ij, r) = separation(xi, view.x[j]);
+        let g = kernel.grad(r_ij, r);
+        let v_j = view.m[j] / view.rho[j];
+        // Lind et al. 2012, Eq. (15): ∇·r = Σ_j V_j (r_j − r_i)·∇_i W_ij (as `position_divergence`)
+        div_r -= v_j * dot(r_ij, g);
+        if r <= 0.0 {
+            continue;
+        }
+        if j < view.n_fluid {
+            fluid[0] += v_j * g[0];
+            fluid[1] += v_j * g[1];
+        }
+        // Sun et al. 2017, Eq. (7): [1 + R (W_ij/W(Δx))^n] V_j ∇_i W_ij, R = 0.2, n = 4
+        let q = kernel.w(r) / w_dx;
+        let f = v_j * (1.0 + R_PAIRING * q * q * q * q);
+        s[0] += f * g[0];
+        s[1] += f * g[1];
+    }
+    if div_r < FREE_SURFACE_DIV_R {
         // DESIGN.md §4.4: free-surface particles are not shifted
         return [0.0, 0.0];
     }
-    let xi = view.x[i];
-    let support = kernel.support();
-    let (mut s, mut r_sum, mut n) = ([0.0, 0.0], 0.0, 0usize);
-    for &j in neighbors {
-        let (r_ij, r) = separation(xi, view.x[j as usize]);
-        if !(r > 0.0 && r < support) {
-            continue;
+    // Sun et al. 2017, Eq. (7): δr = −CFL·Ma·(2h)² Σ…, CFL·Ma = v_max Δt/h; here −K β h v_max Δt Σ…
+    let f = -K_SUN * p.beta * kernel.h() * p.v_max * p.dt;
+    let mut d = [f * s[0], f * s[1]];
+    if div_r < NEAR_SURFACE_DIV_R {
+        // Sun et al. 2017 / Lind et al. 2012 (free-surface treatment): near the surface only the part tangential
+        // to it, normal n = −∇C/|∇C| from the fluid neighbours
+        let len = fluid[0].hypot(fluid[1]);
+        if len > 0.0 {
+            let n = [-fluid[0] / len, -fluid[1] / len];
+            let dn = dot(d, n);
+            d = [d[0] - dn * n[0], d[1] - dn * n[1]];
         }
-        // Xu et al. 2009, Eq. (35) / Shadloo et al. 2012, Eq. (37): Σ_j r_ij / |r_ij|³
-        let r3 = r * r * r;
-        s[0] += r_ij[0] / r3;
-        s[1] += r_ij[1] / r3;
-        // Xu et al. 2009: r̄_i = (1/N_i) Σ_j |r_ij|
-        r_sum += r;
-        n += 1;
     }
-    if n == 0 {
-        return [0.0, 0.0];
-    }
-    let r_bar = r_sum / n as f64;
-    // Xu et al. 2009, Eq. (35): δr_i = C α r̄_i² Σ_j r_ij/|r_ij|³ with α = v_max Δt (C = β)
-    let f = p.beta * r_bar * r_bar * p.v_max * p.dt;
-    let d = [f * s[0], f * s[1]];
     // DESIGN.md §4.4: |δr| ≤ 0.05 h
     let len = d[0].hypot(d[1]);
     let cap = SHIFT_CAP * kernel.h();
