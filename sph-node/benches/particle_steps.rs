@@ -8,6 +8,9 @@
 //!
 //! Environment: `SPH_BENCH_SPACINGS` (comma-separated Δx, default `0.001,0.0005`), `SPH_BENCH_THREADS` (default
 //! `1,2`), `SPH_BENCH_STEPS` (steps per repetition, default 20), `SPH_BENCH_REPS` (default 5).
+//! `SPH_BENCH_SOLVER=isph` measures the ISPH solver on the same scene instead (steps default 3, repetitions 3: a
+//! step solves a PPE; the neighbour and heap columns are not counted for ISPH and print 0; the PPE iterations of
+//! the last step are printed after the row).
 //! `SPH_BENCH_FINGERPRINT=1` instead prints a hash of the state after short runs of a few configurations (default
 //! dam break, MLS + APD, inviscid, a drop without walls), for checking that an optimisation leaves the results
 //! bit-identical.
@@ -15,7 +18,7 @@
 use std::process::Command;
 use std::time::Instant;
 
-use sph_node::WcsphSolver;
+use sph_node::{IsphSolver, WcsphSolver};
 
 fn scene(spacing: f64, extra: &[&str]) -> cosim_proto::scene::Scene {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
@@ -60,6 +63,53 @@ fn env_list<T: std::str::FromStr>(name: &str, default: &str) -> Vec<T> {
 
 fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(default)
+}
+
+/// One size of the ISPH solver, in this process: prints one line per thread count.
+fn run_size_isph(spacing: f64) {
+    let threads: Vec<usize> = env_list("SPH_BENCH_THREADS", "1,2");
+    let steps = env_usize("SPH_BENCH_STEPS", 3);
+    let reps = env_usize("SPH_BENCH_REPS", 3);
+    let before = peak_rss();
+    let mut solver = IsphSolver::new(&scene(spacing, &["fluid.solver=\"isph\""])).unwrap();
+    let n = solver.state().len();
+    let walls = solver.walls().x.len();
+    for _ in 0..2 {
+        let dt = solver.stable_dt();
+        solver.step(dt).unwrap();
+    }
+    let rss = peak_rss().saturating_sub(before) as f64 / n as f64;
+    for t in threads {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
+        let (rates, cpu_rates): (Vec<f64>, Vec<f64>) = (0..reps)
+            .map(|_| {
+                let (t0, c0) = (Instant::now(), cpu_seconds());
+                pool.install(|| {
+                    for _ in 0..steps {
+                        let dt = solver.stable_dt();
+                        solver.step(dt).unwrap();
+                    }
+                });
+                let work = (n * steps) as f64;
+                (
+                    work / t0.elapsed().as_secs_f64() / t as f64,
+                    work / (cpu_seconds() - c0),
+                )
+            })
+            .unzip();
+        let (lo, hi) = rates
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+        println!(
+            "{n:>9} {walls:>7} {t:>7} {:>14.3e} {:>19} {:>12.3e} {:>10.1} {:>10.0} B {rss:>8.0} B  (ISPH, PPE {} it.)",
+            median(rates),
+            format!("{lo:.2e}–{hi:.2e}"),
+            median(cpu_rates),
+            0.0,
+            0.0,
+            solver.last_ppe().iterations,
+        );
+    }
 }
 
 /// One size, in this process: prints one line per thread count.
@@ -114,7 +164,11 @@ fn main() {
         return;
     }
     if let Ok(spacing) = std::env::var("SPH_BENCH_CHILD") {
-        run_size(spacing.parse().unwrap());
+        if std::env::var("SPH_BENCH_SOLVER").is_ok_and(|v| v == "isph") {
+            run_size_isph(spacing.parse().unwrap());
+        } else {
+            run_size(spacing.parse().unwrap());
+        }
         return;
     }
     println!(
