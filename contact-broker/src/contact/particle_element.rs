@@ -144,6 +144,8 @@ pub fn particle_element_with(
         contacts,
         planes,
         plane_contacts,
+        visits,
+        exhaustive,
         ..
     } = ws;
     let (np, nn) = (particles.x.len(), nodes.x.len());
@@ -162,6 +164,8 @@ pub fn particle_element_with(
     inv_m.extend((0..nn).map(|k| if fixed[k] { 0.0 } else { 1.0 / nodes.m[k] }));
     touched.clear();
     touched.resize(np, false);
+    visits.clear();
+    visits.resize(np, Visit::default());
 
     // Segments are binned with their boxes inflated by twice the detection reach, so that a particle's candidate
     // list also covers the places an exact rigid projection may move it to.
@@ -201,11 +205,23 @@ pub fn particle_element_with(
         held = vec![true; nn];
         &held
     };
+    // Every master immovable in this phase (masters held, or all nodes fixed): the nodes do not move, so a visit
+    // depends on nothing but the particle's own position. A particle that a visit left where it was is then
+    // skipped by the later sweeps, and one that also touched nothing in the first sweep by the touch test below:
+    // they would repeat the same detection on the same inputs and find the same nothing (bit-identical result).
+    let nodes_static = !*exhaustive && pos_fixed.iter().all(|&f| f);
     for sweep in 0..params.sweeps {
         let mut worst = 0.0f64;
         #[allow(clippy::needless_range_loop)] // s indexes x, m and touched together
         for s in 0..np {
+            if nodes_static && sweep > 0 && visits[s].still {
+                continue;
+            }
             gather(grid, topo, segments, nodes.x, particles.x[s], inflate, masters);
+            visits[s].still = true;
+            if sweep == 0 {
+                visits[s].clear = true;
+            }
             if masters.is_empty() {
                 continue;
             }
@@ -246,14 +262,27 @@ pub fn particle_element_with(
                 }
                 let d = ctx.detector(nodes.x);
                 let x0 = particles.x[s];
+                let mut penetrated = false;
                 for &m in rigid.iter() {
-                    if let Some(h) = d.detect(m, x0).filter(|h| h.g < 0.0) {
+                    let Some(h) = d.detect(m, x0) else {
+                        continue;
+                    };
+                    if sweep == 0 && step == 0 && h.g <= touch {
+                        visits[s].clear = false;
+                    }
+                    if h.g < 0.0 {
+                        penetrated = true;
                         worst = worst.max(-h.g);
                         if sweep == 0 && step == 0 {
                             note_contact(&mut report, m, h.g);
                         }
                     }
                 }
+                // position_step would find the same (no penetration at x0) and return None.
+                if !penetrated {
+                    break;
+                }
+                visits[s].still = false;
                 let Some(st) = position_step(&d, rigid, x0, tol_round) else {
                     break;
                 };
@@ -278,6 +307,10 @@ pub fn particle_element_with(
     // ---- Contacts after the position phase, geometry frozen at the corrected positions. ----
     contacts.clear();
     for s in 0..np {
+        // Never moved, and the first sweep's detection at this very position found no gap within `touch`.
+        if nodes_static && !touched[s] && visits[s].clear {
+            continue;
+        }
         gather(grid, topo, segments, nodes.x, particles.x[s], inflate, masters);
         let d = ctx.detector(nodes.x);
         for &m in masters.iter() {
@@ -365,6 +398,15 @@ pub fn particle_element_with(
 
     report.particles_corrected = touched.iter().filter(|&&t| t).count();
     Ok(report)
+}
+
+/// What the position phase learnt about one particle, for the skips that hold while the nodes are static.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Visit {
+    /// Its last visit left it where it was (no master penetrated at its position).
+    still: bool,
+    /// Its first-sweep visit found no master within the touch gap at its position.
+    clear: bool,
 }
 
 /// What a [`Detector`] needs besides the node positions, which change during the position phase.
@@ -577,5 +619,86 @@ mod tests {
         let e = run(&[], &ContactParams { sweeps: 0, ..params });
         assert_eq!(e.to_string(), "contact parameter `sweeps` is 0: it must be at least 1");
         assert_eq!((px, pv), ([[0.5, -0.01]], [[0.0, 1.0]]));
+    }
+
+    /// A closed polygon through `corners` with its edges cut into pieces of about `dx`: nodes and segments.
+    fn polygon(corners: &[Vec2], dx: f64) -> (Vec<Vec2>, Vec<Segment>) {
+        let mut x = Vec::new();
+        for (i, &a) in corners.iter().enumerate() {
+            let b = corners[(i + 1) % corners.len()];
+            let n = ((dist(a, b) / dx).round() as usize).max(1);
+            x.extend((0..n).map(|k| axpy(a, k as f64 / n as f64, sub(b, a))));
+        }
+        let s = (0..x.len())
+            .map(|i| Segment {
+                a: i,
+                b: (i + 1) % x.len(),
+            })
+            .collect();
+        (x, s)
+    }
+
+    fn bits(v: &[Vec2]) -> Vec<[u64; 2]> {
+        v.iter().map(|p| [p[0].to_bits(), p[1].to_bits()]).collect()
+    }
+
+    proptest::proptest! {
+        /// The skips taken while the nodes are static (masters held, or all fixed) change no bit of the result.
+        #[test]
+        fn static_node_skips_are_exact(
+            shape in 0usize..3,
+            held in proptest::bool::ANY,
+            sweeps in 1u32..4,
+            offsets in proptest::collection::vec(([0.0f64..1.0, -2.5f64..2.5], [-1.0f64..1.0, -1.0f64..1.0]), 20..400),
+        ) {
+            let dx = 0.01;
+            let corners: Vec<Vec2> = match shape {
+                // A plate (convex, fluid outside), an L (one concave corner), a tank (clockwise: fluid inside).
+                0 => vec![[0.0, 0.0], [0.05, 0.0], [0.05, 0.3], [0.0, 0.3]],
+                1 => vec![[0.0, 0.0], [0.2, 0.0], [0.2, 0.05], [0.05, 0.05], [0.05, 0.2], [0.0, 0.2]],
+                _ => vec![[0.0, 0.0], [0.0, 0.2], [0.3, 0.2], [0.3, 0.0]],
+            };
+            let (nx, segs) = polygon(&corners, dx);
+            let nn = nx.len();
+            // Particles around the boundary: a point along it, then an offset along the normal in [−2.5, 2.5] Δx.
+            let (mut px, mut pv) = (Vec::new(), Vec::new());
+            for &([along, off], v) in &offsets {
+                let j = ((along * segs.len() as f64) as usize).min(segs.len() - 1);
+                let (a, b) = (nx[segs[j].a], nx[segs[j].b]);
+                let f = crate::contact::geometry::Frame::new(a, b, 0.0).unwrap();
+                let t = along * segs.len() as f64 - j as f64;
+                px.push(axpy(f.point(1.0 - t, t), off * dx, f.n));
+                pv.push(v);
+            }
+            let pm = vec![0.1; px.len()];
+            let nm: Vec<f64> = (0..nn).map(|k| 0.5 + (k % 3) as f64).collect();
+            let fixed: Vec<bool> = (0..nn).map(|k| !held || k % 4 != 0).collect();
+            let fixed = if held { fixed } else { vec![true; nn] };
+            let nv: Vec<Vec2> = (0..nn).map(|k| [0.01 * (k % 5) as f64, -0.02]).collect();
+            let params = ContactParams {
+                sweeps,
+                move_masters: !held,
+                ..ContactParams::for_spacing(dx)
+            };
+            let run = |exhaustive: bool| {
+                let (mut px, mut pv, mut nx, mut nv) = (px.clone(), pv.clone(), nx.clone(), nv.clone());
+                let mut ws = ContactWorkspace { exhaustive, ..ContactWorkspace::default() };
+                let p = Particles { x: &mut px, v: &mut pv, m: &pm };
+                let n = Nodes { x: &mut nx, v: &mut nv, m: &nm, fixed: &fixed };
+                let r = particle_element_with(&mut ws, p, n, &segs, &params).unwrap();
+                (bits(&px), bits(&pv), bits(&nx), bits(&nv), bits(&r.node_impulse), bits(&r.node_position_impulse), r)
+            };
+            let (fast, full) = (run(false), run(true));
+            proptest::prop_assume!(full.6.contacts > 0, "no particle penetrates");
+            proptest::prop_assert_eq!(&fast.0, &full.0);
+            proptest::prop_assert_eq!(&fast.1, &full.1);
+            proptest::prop_assert_eq!(&fast.2, &full.2);
+            proptest::prop_assert_eq!(&fast.3, &full.3);
+            proptest::prop_assert_eq!(&fast.4, &full.4);
+            proptest::prop_assert_eq!(&fast.5, &full.5);
+            let strip = |r: &ContactReport| (r.contacts, r.node_contacts, r.touching, r.particles_corrected,
+                r.position_sweeps, r.velocity_sweeps, r.max_penetration.to_bits(), r.residual_penetration.to_bits());
+            proptest::prop_assert_eq!(strip(&fast.6), strip(&full.6));
+        }
     }
 }

@@ -2,7 +2,7 @@
 
 use super::detection::{Master, Topology};
 use super::grid::CellGrid;
-use super::particle_element::Contact;
+use super::particle_element::{Contact, Visit};
 use super::particle_particle::BoundaryPoint;
 use super::rigid::HalfPlane;
 
@@ -21,4 +21,7 @@ pub struct ContactWorkspace {
     pub(crate) planes: Vec<HalfPlane>,
     pub(crate) plane_contacts: Vec<usize>,
     pub(crate) points: Vec<BoundaryPoint>,
+    pub(crate) visits: Vec<Visit>,
+    /// Visit every particle in every sweep even where the nodes are static (tests compare the two).
+    pub(crate) exhaustive: bool,
 }
