@@ -3,16 +3,17 @@
 //! distributed.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
 
-use cosim_proto::messages::{FemState, SphSetup, SphSnapshot, SphState, StepCommand};
+use cosim_proto::messages::{FemState, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{LoadedScene, SceneError};
 
 use crate::interface::{Corrections, Interface, PassStats};
 use crate::link::{FemLink, LinkError, Reply, SphLink};
-use crate::output::{plot_probe, FrameWriter, PointField, ProbeCsv};
+use crate::output::{plot_probe, FrameQueue, FrameWriter, PointField, ProbeCsv};
 use crate::probes::Probes;
 use crate::summary::{ContactStats, Summary, Timings};
 
@@ -161,12 +162,16 @@ fn drive(
     )
     .map_err(anyhow::Error::msg)?;
     *series = vec![Vec::new(); probes.names().len()];
-    let mut frames = FrameWriter::new(&info.out)?;
+    // Frames are encoded and written on their own thread (output/queue.rs), from the snapshots handed over.
+    let mut frames = FrameQueue::new(FrameWriter::new(&info.out)?)?;
+    let mesh = nodes.fem.as_ref().map(|f| Arc::new(f.setup().clone()));
+    let walls = nodes.sph.as_ref().map(|n| Arc::new(n.setup().walls.clone()));
+    let density = nodes.sph.as_ref().map_or(0.0, |n| n.setup().density);
     let mut csv = ProbeCsv::create(&info.out.join("probes.csv"), probes.names())?;
     let interval = s.run.output_interval;
     let end = s.run.end_time;
     let mut sample = |t: f64,
-                      round: &Round,
+                      round: &mut Round,
                       nodes: &Nodes<'_>,
                       load: Option<&[[f64; 2]]>,
                       summary: &mut Summary|
@@ -186,11 +191,15 @@ fn drive(
             line.push((t, *v));
         }
         let index = summary.frames as usize;
-        if let Some((mesh, snap)) = fem {
-            frames.write_structure(index, t, mesh, snap, load)?;
+        if let (Some(mesh), Some(snap)) = (&mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
+            let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
+            frames.push(Box::new(move |w| {
+                w.write_structure(index, t, &mesh, &snap, load.as_deref()).map(drop)
+            }))?;
         }
-        if let Some((setup, snap)) = sph {
-            write_particles(&mut frames, index, t, setup, snap)?;
+        if let (Some(walls), Some(snap)) = (&walls, round.sph.as_mut().and_then(|s| s.snapshot.take())) {
+            let walls = Arc::clone(walls);
+            frames.push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
         }
         summary.frames += 1;
         summary.samples += 1;
@@ -215,8 +224,8 @@ fn drive(
     let mut t = 0.0;
     let mut step = 0u64;
     let coupled = interface.is_some();
-    let round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
-    sample(t, &round, nodes, load.as_deref(), summary)?;
+    let mut round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
+    sample(t, &mut round, nodes, load.as_deref(), summary)?;
     let mut dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
     let mut next_output = 1u64;
     while t < end {
@@ -234,7 +243,7 @@ fn drive(
             dt = target - t;
         }
         step += 1;
-        let round = exchange(nodes, summary, step, t, commands(dt, lands, coupled, roi, &mut pending))?;
+        let mut round = exchange(nodes, summary, step, t, commands(dt, lands, coupled, roi, &mut pending))?;
         if let Some(state) = &round.fem {
             summary.fem_substeps += u64::from(state.substeps);
         }
@@ -261,7 +270,7 @@ fn drive(
             summary.timings.broker += started.elapsed().as_secs_f64();
         }
         if lands {
-            sample(t, &round, nodes, load.as_deref(), summary)?;
+            sample(t, &mut round, nodes, load.as_deref(), summary)?;
             if target >= next_output as f64 * interval {
                 next_output += 1;
             }
@@ -275,6 +284,11 @@ fn drive(
     if let Some(link) = nodes.sph.as_deref_mut() {
         link.send(step + 1, t, stop)?;
     }
+    // The frames still being written count as the broker's time.
+    let started = Instant::now();
+    let written = frames.finish();
+    summary.timings.broker += started.elapsed().as_secs_f64();
+    written?;
     Ok(())
 }
 
@@ -326,16 +340,18 @@ fn snapshot<'s, T>(snap: Option<&'s T>, node: &str) -> anyhow::Result<&'s T> {
     snap.ok_or_else(|| anyhow::anyhow!("{node}: answered an output step without a snapshot"))
 }
 
-/// Fluid and wall particles in one frame, told apart by `wall` (0 fluid, 1 wall).
+/// Fluid and wall particles (walls at `wall_x`, of density `density`) in one frame, told apart by `wall` (0 fluid,
+/// 1 wall).
 fn write_particles(
     frames: &mut FrameWriter,
     index: usize,
     t: f64,
-    setup: &SphSetup,
+    wall_x: &[[f64; 2]],
+    density: f64,
     snap: &SphSnapshot,
-) -> anyhow::Result<()> {
-    let x: Vec<[f64; 2]> = snap.x.iter().chain(&setup.walls).copied().collect();
-    let walls = setup.walls.len();
+) -> crate::output::Result<()> {
+    let x: Vec<[f64; 2]> = snap.x.iter().chain(wall_x).copied().collect();
+    let walls = wall_x.len();
     let v: Vec<[f64; 2]> = snap
         .v
         .iter()
@@ -347,7 +363,7 @@ fn write_particles(
         .rho
         .iter()
         .copied()
-        .chain(std::iter::repeat_n(setup.density, walls))
+        .chain(std::iter::repeat_n(density, walls))
         .collect();
     let kind: Vec<f64> = std::iter::repeat_n(0.0, snap.x.len())
         .chain(std::iter::repeat_n(1.0, walls))
@@ -367,7 +383,9 @@ fn write_particles(
 }
 
 /// One coupling step with every node: send to all, then collect all, so processes compute side by side. The
-/// nodes' own compute time counts as `fem`/`sph`; the rest of the round, beyond the slower node, as `messaging`.
+/// nodes' own compute time counts as `fem`/`sph`; the rest of the round as `messaging`: beyond the slower node where
+/// the nodes compute side by side (other processes), beyond their sum where they compute one after the other inside
+/// `receive` (in this process).
 fn exchange(
     nodes: &mut Nodes<'_>,
     summary: &mut Summary,
@@ -396,7 +414,18 @@ fn exchange(
     let c_sph = sph.as_ref().map_or(0.0, |s| s.compute_seconds());
     summary.timings.fem += c_fem;
     summary.timings.sph += c_sph;
-    summary.timings.messaging += (wall - c_fem.max(c_sph)).max(0.0);
+    let (mut side_by_side, mut in_turn) = (0.0f64, 0.0);
+    for (concurrent, c) in [
+        (nodes.fem.as_ref().is_none_or(|l| l.concurrent()), c_fem),
+        (nodes.sph.as_ref().is_none_or(|l| l.concurrent()), c_sph),
+    ] {
+        if concurrent {
+            side_by_side = side_by_side.max(c);
+        } else {
+            in_turn += c;
+        }
+    }
+    summary.timings.messaging += (wall - side_by_side - in_turn).max(0.0);
     Ok(Round { fem, sph })
 }
 

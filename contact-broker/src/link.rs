@@ -70,6 +70,13 @@ pub trait NodeLink {
 
     /// The node's answer to the command of step `step`.
     fn receive(&mut self, step: u64) -> Result<Self::State, LinkError>;
+
+    /// Whether the node computes on its own while the coordinator waits (another process), rather than inside
+    /// [`NodeLink::receive`], one node after the other (this process). Decides how a round's time is split
+    /// between the nodes and messaging.
+    fn concurrent(&self) -> bool {
+        true
+    }
 }
 
 /// The structure node.
@@ -124,5 +131,9 @@ impl<S, T: Reply> NodeLink for InProcess<S, T> {
             node: "in-process node".into(),
             message: format!("no answer to step {step}"),
         })
+    }
+
+    fn concurrent(&self) -> bool {
+        false
     }
 }

@@ -12,7 +12,9 @@ mod compare;
 mod csv;
 mod plot;
 mod pvd;
+mod queue;
 mod vtk;
+mod vtu;
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +22,7 @@ pub use compare::plot_compare;
 pub use csv::ProbeCsv;
 pub use plot::{plot_probe, read_reference};
 pub use pvd::PvdCollection;
+pub use queue::{FrameJob, FrameQueue};
 pub use vtk::{von_mises_2d, FrameWriter, PointField};
 
 /// An output file could not be written, or an input to it was unusable. Each variant names the file.
