@@ -607,3 +607,44 @@ fn corners() {
         body.pv
     );
 }
+
+/// A structure thinner than the far-side depth minus r_c (the elastic gate, 5 mm, at Δx ≥ 5 mm): a particle resting
+/// in front of one face lies within d_max behind the opposite face, but it is outside the structure and must not be
+/// taken as having passed through that face (it was thrown through the gate, at the first steps of the 5 mm gate).
+/// A particle that is inside is still put out.
+#[test]
+fn thin_structure_particle_in_front_of_one_face_is_not_through_the_other() {
+    let params = ContactParams {
+        thickness: 0.05,
+        far_side: 0.15,
+        sweeps: 3,
+        tolerance: 1e-9,
+        move_masters: true,
+    };
+    // Counter-clockwise plate 1.0 x 0.05, fixed: the fluid is outside it.
+    let mut plate = Scene {
+        dx: 0.1,
+        nx: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 0.05], [0.0, 0.05]],
+        nv: vec![[0.0; 2]; 4],
+        nm: vec![1.0; 4],
+        fixed: vec![true; 4],
+        segs: (0..4).map(|i| Segment { a: i, b: (i + 1) % 4 }).collect(),
+        // Under the plate, 0.06 from its lower face (clear of r_c = 0.05) and 0.11 behind its upper face.
+        px: vec![[0.5, -0.06]],
+        pv: vec![[0.0, 0.1]],
+        pm: vec![1.0],
+    };
+    let before = (plate.px.clone(), plate.pv.clone());
+    let r = plate.element(&params);
+    assert_eq!(r.contacts, 0);
+    assert_eq!(bits(&plate.px), bits(&before.0), "moved: {:?}", plate.px);
+    assert_eq!(bits(&plate.pv), bits(&before.1), "slowed: {:?}", plate.pv);
+
+    // Inside the plate, 0.01 under its upper face: put out of it, clear of r_c on one side or the other.
+    plate.px = vec![[0.5, 0.04]];
+    plate.pv = vec![[0.0, -0.1]];
+    let r = plate.element(&params);
+    assert!(r.contacts >= 1);
+    let y = plate.px[0][1];
+    assert!(y >= 0.1 - 1e-12 || y <= -0.05 + 1e-12, "left at y = {y}");
+}
