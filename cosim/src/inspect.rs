@@ -93,8 +93,12 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         // Listening too: the nodes learn of the inspector through the broker (gossip) and connect to it, which is
         // how their status reaches it (peers do not forward for each other). Zenoh gossips the addresses of a
         // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for the inspector's few seconds only).
-        false => open_listening(&["tcp/0.0.0.0:0".to_string()], std::slice::from_ref(&connect), timeout_ms)
-            .map(|(s, _)| s),
+        false => open_listening(
+            &["tcp/0.0.0.0:0".to_string()],
+            std::slice::from_ref(&connect),
+            timeout_ms,
+        )
+        .map(|(s, _)| s),
     }
     .map_err(|e| anyhow::anyhow!("cannot reach run `{}` at {connect}: {e:#}", args.id))?;
     // Let zenoh learn the run's queryables (gossip) before the first question.
