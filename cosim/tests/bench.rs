@@ -130,32 +130,33 @@ fn dam_break_error_falls_with_spacing_and_outputs_are_written() {
 
 #[test]
 fn a_blown_up_case_is_a_record_not_an_abort() {
-    // The plate's side walls are 0.075 m thick: at 0.05 m spacing they hold 1.5 layers and particles leak out at
-    // once; at 0.025 m the run is sound.
+    // ISPH with the particle-particle contact is unstable on the gate (docs/VALIDATION.md): the gate's elements
+    // invert about 0.09-0.12 s in at these spacings. The first case blows up and the bench goes on to the second.
     let (output, out) = bench(
         "unstable",
         &[
             "--only",
-            "hydrostatic_plate",
+            "elastic_gate",
             "--solver",
-            "wcsph",
+            "isph",
+            "--contact",
+            "particle_particle",
             "--spacing",
-            "0.05,0.025",
+            "0.006,0.0045",
             "--end-time",
-            "0.06",
+            "0.15",
         ],
     );
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "some case failed: {stderr}");
     let list = records(&out);
     assert_eq!(list.len(), 2, "the bench went on after the failure");
-    assert_eq!(list[0]["status"], "unstable", "{}", list[0]);
-    assert!(list[0]["message"].as_str().unwrap().contains("sph-node"), "{}", list[0]);
-    assert!(list[0]["error"].is_null(), "no error for a blown-up run");
-    assert_eq!(list[1]["status"], "ok", "{}", list[1]);
-    assert_eq!(list[1]["contact"], "particle_element");
-    let w = list[1]["value"].as_f64().unwrap();
-    assert!(w < 0.0 && w.is_finite(), "the plate sags: {w}");
+    for r in &list {
+        assert_eq!(r["status"], "unstable", "{r}");
+        assert_eq!(r["contact"], "particle_particle");
+        assert!(r["message"].as_str().unwrap().contains("inverted element"), "{r}");
+        assert!(r["error"].is_null(), "no error for a blown-up run");
+    }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("**unstable**"), "{report}");
     assert_svg(&std::fs::read_to_string(out.join("pareto.svg")).unwrap());
