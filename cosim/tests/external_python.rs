@@ -15,7 +15,7 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::*;
@@ -50,27 +50,6 @@ fn python() -> PathBuf {
         probe.map(|o| String::from_utf8_lossy(&o.stderr).into_owned())
     );
     chosen
-}
-
-/// Kills the child when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// Wait for `child` at most until `until`; its exit status.
-fn wait_until(child: &mut Child, until: Instant, what: &str) -> std::process::ExitStatus {
-    loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            return s;
-        }
-        assert!(Instant::now() < until, "{what} did not finish within {LIMIT:?}");
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 /// The rigid plate on springs of `examples/python/rigid_plate_node.py`, written again in Rust with the same
@@ -288,8 +267,8 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
             .spawn()
             .unwrap(),
     );
-    let status = wait_until(&mut cosim_run.0, until, "cosim run --external fem");
-    let node_status = wait_until(&mut node.0, until, "the Python node");
+    let status = wait_exit(&mut cosim_run.0, until, "cosim run --external fem");
+    let node_status = wait_exit(&mut node.0, until, "the Python node");
     let logs = || {
         format!(
             "cosim: {}\npython: {}",

@@ -6,22 +6,12 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::{Command, Stdio};
+use std::time::Duration;
 
 use common::*;
 
 const LIMIT: Duration = Duration::from_secs(120);
-
-/// Kills the child when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// The coarse gate as processes, not waited for.
 fn start(out: &Path, id: &str, end_time: &str) -> Kill {
@@ -43,10 +33,6 @@ fn start(out: &Path, id: &str, end_time: &str) -> Kill {
             .spawn()
             .unwrap(),
     )
-}
-
-fn samples(out: &Path) -> usize {
-    std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().skip(1).count())
 }
 
 fn inspect(args: &[&str]) -> (i32, serde_json::Value, String) {
@@ -94,12 +80,7 @@ fn inspect_a_running_coupled_run() {
     let out = dir.join("out");
     let id = run_id("inspect");
     let mut run = start(&out, &id, "10");
-    let started = Instant::now();
-    while samples(&out) < 3 {
-        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
-        assert!(started.elapsed() < LIMIT, "the run did not get going");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    wait_for_samples(&mut run.0, &out, 3, LIMIT);
     // Found on this machine by its id.
     let (code, doc, text) = inspect(&[&id, "--once"]);
     assert_eq!(code, 0, "{text}");
@@ -123,12 +104,7 @@ fn the_table_follows_a_run_to_its_end() {
     let out = dir.join("out");
     let id = run_id("inspect-live");
     let mut run = start(&out, &id, "0.25");
-    let started = Instant::now();
-    while samples(&out) < 2 {
-        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
-        assert!(started.elapsed() < LIMIT, "the run did not get going");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_for_samples(&mut run.0, &out, 2, LIMIT);
     let table = cosim_run(&["inspect", &id, "--interval", "0.2"], LIMIT);
     let text = String::from_utf8_lossy(&table.stdout);
     assert!(

@@ -8,7 +8,7 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::*;
@@ -16,16 +16,6 @@ use zenoh::Wait;
 
 const LIMIT: Duration = Duration::from_secs(300);
 const SCENE: &str = "scenes/elastic_gate.toml";
-
-/// Kills the child when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// `cosim run SCENE` with the variant's settings; not waited for.
 fn start(out: &Path, id: &str, contact: &str, extra: &[&str]) -> Kill {
@@ -45,18 +35,7 @@ fn start(out: &Path, id: &str, contact: &str, extra: &[&str]) -> Kill {
 }
 
 fn finish(run: &mut Kill, out: &Path) {
-    let until = Instant::now() + LIMIT;
-    let status = loop {
-        if let Some(s) = run.0.try_wait().unwrap() {
-            break s;
-        }
-        assert!(
-            Instant::now() < until,
-            "{} did not finish within {LIMIT:?}",
-            out.display()
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let status = wait_exit(&mut run.0, Instant::now() + LIMIT, &out.display().to_string());
     let stderr = std::fs::read_to_string(out.with_extension("stderr")).unwrap_or_default();
     assert!(status.success(), "{}: {stderr}", out.display());
 }

@@ -6,8 +6,7 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::*;
@@ -23,16 +22,6 @@ const SETS: [&str; 4] = [
     "coupling.step_timeout=2",
     "run.output_interval=0.005",
 ];
-
-/// Kills the child when dropped.
-struct Kill(Child);
-
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// The pids and program names of `pid`'s children.
 fn children(pid: u32) -> Vec<(u32, String)> {
@@ -56,11 +45,6 @@ fn alive(pid: u32) -> bool {
     std::fs::read_to_string(format!("/proc/{pid}/stat"))
         .map(|s| s.rsplit_once(") ").is_some_and(|(_, rest)| !rest.starts_with('Z')))
         .unwrap_or(false)
-}
-
-/// Data rows of `probes.csv` so far.
-fn samples(out: &Path) -> usize {
-    std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().skip(1).count())
 }
 
 /// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
@@ -103,13 +87,7 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
     let hit = Instant::now();
     let sent = Command::new("kill").args([signal, &pid.to_string()]).status().unwrap();
     assert!(sent.success());
-    let status = loop {
-        if let Some(s) = run.0.try_wait().unwrap() {
-            break s;
-        }
-        assert!(hit.elapsed() < LIMIT, "cosim did not stop after {victim} got {signal}");
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let status = wait_exit(&mut run.0, hit + LIMIT, &format!("cosim after {signal} to {victim}"));
     let took = hit.elapsed();
     let stderr = std::fs::read_to_string(&stderr_path).unwrap();
     eprintln!(

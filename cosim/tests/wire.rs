@@ -86,21 +86,23 @@ fn bad_messages_on_every_topic_are_refused_and_change_nothing() {
     let dir = scratch("wire");
     let (out, reference) = (dir.join("out"), dir.join("reference"));
     let id = run_id("wire");
-    let mut run = Command::new(cosim())
-        .current_dir(root())
-        .env("COSIM_BIN_DIR", bin_dir())
-        .args(["run", "scenes/elastic_gate.toml", "--quiet", "--run-id", &id, "--out"])
-        .arg(&out)
-        .args(SETS)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(dir.join("stderr.txt")).unwrap())
-        .spawn()
-        .unwrap();
+    let mut run = Kill(
+        Command::new(cosim())
+            .current_dir(root())
+            .env("COSIM_BIN_DIR", bin_dir())
+            .args(["run", "scenes/elastic_gate.toml", "--quiet", "--run-id", &id, "--out"])
+            .arg(&out)
+            .args(SETS)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(dir.join("stderr.txt")).unwrap())
+            .spawn()
+            .unwrap(),
+    );
     let started = Instant::now();
     let registry = std::env::temp_dir().join("cosim-runs").join(format!("{id}.json"));
     while !registry.exists() {
-        assert!(run.try_wait().unwrap().is_none(), "the run ended early");
+        assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
         assert!(started.elapsed() < LIMIT, "the run did not start");
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -129,16 +131,7 @@ fn bad_messages_on_every_topic_are_refused_and_change_nothing() {
         }
         std::thread::sleep(Duration::from_millis(300));
     }
-    let status = loop {
-        if let Some(s) = run.try_wait().unwrap() {
-            break s;
-        }
-        if started.elapsed() > LIMIT {
-            let _ = run.kill();
-            panic!("the run did not finish within {LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let status = wait_exit(&mut run.0, started + LIMIT, "the disturbed run");
     drop(session);
     let stderr = std::fs::read_to_string(dir.join("stderr.txt")).unwrap();
     assert!(status.success(), "the run failed: {stderr}");

@@ -80,36 +80,45 @@ fn run_size_isph(spacing: f64) {
     }
     let rss = peak_rss().saturating_sub(before) as f64 / n as f64;
     for t in threads {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
-        let (rates, cpu_rates): (Vec<f64>, Vec<f64>) = (0..reps)
-            .map(|_| {
-                let (t0, c0) = (Instant::now(), cpu_seconds());
-                pool.install(|| {
-                    for _ in 0..steps {
-                        let dt = solver.stable_dt();
-                        solver.step(dt).unwrap();
-                    }
-                });
-                let work = (n * steps) as f64;
-                (
-                    work / t0.elapsed().as_secs_f64() / t as f64,
-                    work / (cpu_seconds() - c0),
-                )
-            })
-            .unzip();
-        let (lo, hi) = rates
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+        let (rates, cpu_rates, lo, hi) = measure(t, n, steps, reps, || {
+            let dt = solver.stable_dt();
+            solver.step(dt).unwrap();
+        });
         println!(
             "{n:>9} {walls:>7} {t:>7} {:>14.3e} {:>19} {:>12.3e} {:>10.1} {:>10.0} B {rss:>8.0} B  (ISPH, PPE {} it.)",
-            median(rates),
+            rates,
             format!("{lo:.2e}–{hi:.2e}"),
-            median(cpu_rates),
+            cpu_rates,
             0.0,
             0.0,
             solver.last_ppe().iterations,
         );
     }
+}
+
+/// `reps` runs of `steps` calls of `step` on `threads` threads, over `n` particles: median particle-steps per second
+/// per core, median per CPU-second, and the lowest and highest per core.
+fn measure(threads: usize, n: usize, steps: usize, reps: usize, mut step: impl FnMut() + Send) -> (f64, f64, f64, f64) {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let (rates, cpu_rates): (Vec<f64>, Vec<f64>) = (0..reps)
+        .map(|_| {
+            let (t0, c0) = (Instant::now(), cpu_seconds());
+            pool.install(|| {
+                for _ in 0..steps {
+                    step();
+                }
+            });
+            let work = (n * steps) as f64;
+            (
+                work / t0.elapsed().as_secs_f64() / threads as f64,
+                work / (cpu_seconds() - c0),
+            )
+        })
+        .unzip();
+    let (lo, hi) = rates
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+    (median(rates), median(cpu_rates), lo, hi)
 }
 
 /// One size, in this process: prints one line per thread count.
@@ -129,31 +138,15 @@ fn run_size(spacing: f64) {
     let neighbours = solver.pair_count() as f64 / n as f64;
     let heap = solver.heap_bytes() as f64 / n as f64;
     for t in threads {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
-        let (rates, cpu_rates): (Vec<f64>, Vec<f64>) = (0..reps)
-            .map(|_| {
-                let (t0, c0) = (Instant::now(), cpu_seconds());
-                pool.install(|| {
-                    for _ in 0..steps {
-                        let dt = solver.stable_dt();
-                        solver.step(dt).unwrap();
-                    }
-                });
-                let work = (n * steps) as f64;
-                (
-                    work / t0.elapsed().as_secs_f64() / t as f64,
-                    work / (cpu_seconds() - c0),
-                )
-            })
-            .unzip();
-        let (lo, hi) = rates
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+        let (rates, cpu_rates, lo, hi) = measure(t, n, steps, reps, || {
+            let dt = solver.stable_dt();
+            solver.step(dt).unwrap();
+        });
         println!(
             "{n:>9} {walls:>7} {t:>7} {:>14.3e} {:>19} {:>12.3e} {neighbours:>10.1} {heap:>10.0} B {rss:>8.0} B",
-            median(rates),
+            rates,
             format!("{lo:.2e}–{hi:.2e}"),
-            median(cpu_rates),
+            cpu_rates,
         );
     }
 }

@@ -127,17 +127,23 @@ impl Detector<'_> {
         if !topo.closed || topo.loops == 0 {
             return true;
         }
-        let mut crossings = vec![false; topo.loops];
-        let mut area = vec![0.0; topo.loops];
-        for (j, s) in self.segments.iter().enumerate() {
-            let (a, b) = (self.x[s.a], self.x[s.b]);
-            let l = topo.loop_of[j] as usize;
-            area[l] += cross(a, b);
-            if (a[1] > xs[1]) != (b[1] > xs[1]) && xs[0] < a[0] + (xs[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) {
-                crossings[l] = !crossings[l];
+        // Loop by loop (a few: one per solid), without allocating in the detection path.
+        let mut inside = false;
+        for l in 0..topo.loops as u32 {
+            let (mut area, mut crossing) = (0.0, false);
+            for (s, _) in self.segments.iter().zip(&topo.loop_of).filter(|(_, &o)| o == l) {
+                let (a, b) = (self.x[s.a], self.x[s.b]);
+                area += cross(a, b);
+                if (a[1] > xs[1]) != (b[1] > xs[1]) && xs[0] < a[0] + (xs[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) {
+                    crossing = !crossing;
+                }
             }
+            if area <= 0.0 {
+                return true;
+            }
+            inside |= crossing;
         }
-        area.iter().any(|&a| a <= 0.0) || crossings.iter().any(|&c| c)
+        inside
     }
 
     /// Whether the master cannot move (all its nodes fixed: infinite mass, 1/m = 0).

@@ -87,3 +87,39 @@ pub fn free_port() -> u16 {
         .unwrap()
         .port()
 }
+
+/// A child process that is killed (and reaped) when dropped, so a test that fails leaves nothing running.
+pub struct Kill(pub std::process::Child);
+
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Wait for `child` to exit, at most until `until`; panics naming `what` otherwise.
+pub fn wait_exit(child: &mut std::process::Child, until: Instant, what: &str) -> std::process::ExitStatus {
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        assert!(Instant::now() < until, "{what} did not finish in time");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Data rows of `DIR/probes.csv` written so far.
+pub fn samples(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().skip(1).count())
+}
+
+/// Wait until the run writing to `out` has `n` probe samples; panics if it ends first or takes over `limit`.
+pub fn wait_for_samples(run: &mut std::process::Child, out: &Path, n: usize, limit: Duration) {
+    let started = Instant::now();
+    while samples(out) < n {
+        assert!(run.try_wait().unwrap().is_none(), "the run ended early");
+        assert!(started.elapsed() < limit, "the run did not get going");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}

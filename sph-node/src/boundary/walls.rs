@@ -15,26 +15,31 @@ pub fn layers_needed(dx: f64, h: f64) -> usize {
     MIN_LAYERS.max((2.0 * h / dx - 1e-9).ceil() as usize)
 }
 
+/// The region `wall`'s particles fill: the box itself, or a box thinner than [`layers_needed`] rows grown away from
+/// the fluid (`fluid_centre` tells which side faces it) so that it still holds them. (lower, upper) corner.
+pub fn filled_box(wall: &BoxSpec, dx: f64, h: f64, fluid_centre: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    let layers = layers_needed(dx, h) as f64;
+    let (mut lo, mut hi) = (wall.min, wall.max);
+    for k in 0..2 {
+        let need = layers * dx - (hi[k] - lo[k]);
+        if need > 1e-12 {
+            if 0.5 * (lo[k] + hi[k]) < fluid_centre[k] {
+                lo[k] -= need;
+            } else {
+                hi[k] += need;
+            }
+        }
+    }
+    (lo, hi)
+}
+
 /// Wall particle positions for `walls`, on the lattice x = origin + (k + ½) Δx. `fluid_centre` tells a thin box
 /// which side faces the fluid. Points shared by overlapping boxes appear once; the order is by lattice row, then
 /// column.
 pub fn wall_positions(walls: &[BoxSpec], origin: [f64; 2], dx: f64, h: f64, fluid_centre: [f64; 2]) -> Vec<[f64; 2]> {
-    let layers = layers_needed(dx, h) as f64;
     let mut points: BTreeSet<(i64, i64)> = BTreeSet::new();
     for wall in walls {
-        let mut lo = wall.min;
-        let mut hi = wall.max;
-        for k in 0..2 {
-            let need = layers * dx - (hi[k] - lo[k]);
-            if need > 1e-12 {
-                // Thin box: grow it away from the fluid so that it still holds `layers` rows.
-                if 0.5 * (lo[k] + hi[k]) < fluid_centre[k] {
-                    lo[k] -= need;
-                } else {
-                    hi[k] += need;
-                }
-            }
-        }
+        let (lo, hi) = filled_box(wall, dx, h, fluid_centre);
         let tol = 1e-9 * dx;
         let first = [0, 1].map(|k| ((lo[k] - origin[k]) / dx - 0.5 - 1e-9).ceil() as i64);
         let last = [0, 1].map(|k| ((hi[k] - origin[k]) / dx - 0.5 + 1e-9).floor() as i64);

@@ -17,7 +17,7 @@
 
 use cosim_proto::scene::BoxSpec;
 
-use crate::boundary::walls::layers_needed;
+use crate::boundary::walls::filled_box;
 
 /// The wall boxes of a scene.
 #[derive(Clone, Debug, Default)]
@@ -31,24 +31,7 @@ impl WallBoxes {
     /// The boxes of `walls`, each grown away from the fluid to the layers its particles fill (as
     /// [`crate::boundary::walls::wall_positions`] does for a box thinner than the kernel support).
     pub fn new(walls: &[BoxSpec], dx: f64, h: f64, fluid_centre: [f64; 2]) -> Self {
-        let layers = layers_needed(dx, h) as f64;
-        let boxes = walls
-            .iter()
-            .map(|w| {
-                let (mut lo, mut hi) = (w.min, w.max);
-                for k in 0..2 {
-                    let need = layers * dx - (hi[k] - lo[k]);
-                    if need > 1e-12 {
-                        if 0.5 * (lo[k] + hi[k]) < fluid_centre[k] {
-                            lo[k] -= need;
-                        } else {
-                            hi[k] += need;
-                        }
-                    }
-                }
-                (lo, hi)
-            })
-            .collect();
+        let boxes = walls.iter().map(|w| filled_box(w, dx, h, fluid_centre)).collect();
         Self {
             boxes,
             margin: 1e-6 * dx,
