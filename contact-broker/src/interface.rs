@@ -73,11 +73,18 @@ impl Interface {
             f.blocks.iter().map(|b| b.max[1] - b.min[1]).fold(0.0, f64::max)
         });
         let g = scene.run.gravity[0].hypot(scene.run.gravity[1]);
-        // Far-side limit r_c + Δx: below the thinnest structure (+ r_c) the scenes mesh, so particles on one face
-        // are never caught by the opposite face's segments.
+        // Far-side limit r_c + Δx, but never more than r_c + half the thinnest solid: a particle resting r_c in
+        // front of one face lies T + r_c behind the opposite face of a solid T thick, so d_max must stay below that
+        // or the opposite face's segments take it for a particle through them and throw it across (the 5 mm gate
+        // at Δx ≥ 5 mm did, at its first steps).
+        let thinnest = scene
+            .solids
+            .iter()
+            .map(|s| (s.max[0] - s.min[0]).min(s.max[1] - s.min[1]))
+            .fold(f64::INFINITY, f64::min);
         let element = contact::ContactParams {
             thickness,
-            far_side: thickness + dx,
+            far_side: thickness + dx.min(0.5 * thinnest),
             sweeps,
             move_masters: scene.contact.move_structure,
             ..contact::ContactParams::for_spacing(dx)

@@ -608,15 +608,16 @@ fn corners() {
     );
 }
 
-/// A structure thinner than the far-side depth minus r_c (the elastic gate, 5 mm, at Δx ≥ 5 mm): a particle resting
-/// in front of one face lies within d_max behind the opposite face, but it is outside the structure and must not be
-/// taken as having passed through that face (it was thrown through the gate, at the first steps of the 5 mm gate).
-/// A particle that is inside is still put out.
+/// A structure thinner than Δx (the elastic gate, 5 mm, at Δx ≥ 5 mm): a particle resting in front of one face
+/// lies T + r_c behind the opposite face, so the broker limits d_max to r_c + min(Δx, T/2) (`interface.rs`); with
+/// that limit the particle is not taken as having passed through the opposite face (with d_max = r_c + Δx it was,
+/// and was thrown through the gate at the first steps of the 5 mm gate). A particle that is inside is still put out.
 #[test]
 fn thin_structure_particle_in_front_of_one_face_is_not_through_the_other() {
+    // Δx = 0.1, r_c = 0.05, T = 0.05: d_max = r_c + min(Δx, T/2) = 0.075 (r_c + Δx would be 0.15).
     let params = ContactParams {
         thickness: 0.05,
-        far_side: 0.15,
+        far_side: 0.075,
         sweeps: 3,
         tolerance: 1e-9,
         move_masters: true,

@@ -41,12 +41,6 @@ pub(crate) enum Shape {
 pub(crate) struct Topology {
     prev: Vec<u32>,
     next: Vec<u32>,
-    /// Every segment's ends continue into another segment: the boundary is closed loops, so it has an inside.
-    closed: bool,
-    /// The loop each segment belongs to (following each segment's end into the next), when `closed`.
-    loop_of: Vec<u32>,
-    /// Number of loops.
-    loops: usize,
 }
 
 impl Topology {
@@ -62,25 +56,6 @@ impl Topology {
             }
             if self.next[s.a] == NONE {
                 self.next[s.a] = j as u32;
-            }
-        }
-        self.closed = segments
-            .iter()
-            .all(|s| self.prev[s.a] != NONE && self.next[s.b] != NONE);
-        self.loop_of.clear();
-        self.loop_of.resize(segments.len(), NONE);
-        self.loops = 0;
-        if self.closed {
-            for start in 0..segments.len() {
-                if self.loop_of[start] != NONE {
-                    continue;
-                }
-                let mut k = start;
-                while self.loop_of[k] == NONE {
-                    self.loop_of[k] = self.loops as u32;
-                    k = self.next[segments[k].b] as usize;
-                }
-                self.loops += 1;
             }
         }
     }
@@ -116,34 +91,6 @@ impl Detector<'_> {
     fn frame(&self, j: u32) -> Option<Frame> {
         let s = self.segments[j as usize];
         Frame::new(self.x[s.a], self.x[s.b], self.min_len)
-    }
-
-    /// Whether `xs` can be inside the structure. For a boundary of closed counter-clockwise loops (bodies: every
-    /// FE mesh's outer boundary) that is "inside one of the loops" (crossing number of a ray towards +x, loop by
-    /// loop). A boundary with open ends or a clockwise loop (a container, whose structure is outside it) gives
-    /// `true`: no restriction.
-    fn may_be_inside(&self, xs: Vec2) -> bool {
-        let topo = self.topo;
-        if !topo.closed || topo.loops == 0 {
-            return true;
-        }
-        // Loop by loop (a few: one per solid), without allocating in the detection path.
-        let mut inside = false;
-        for l in 0..topo.loops as u32 {
-            let (mut area, mut crossing) = (0.0, false);
-            for (s, _) in self.segments.iter().zip(&topo.loop_of).filter(|(_, &o)| o == l) {
-                let (a, b) = (self.x[s.a], self.x[s.b]);
-                area += cross(a, b);
-                if (a[1] > xs[1]) != (b[1] > xs[1]) && xs[0] < a[0] + (xs[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]) {
-                    crossing = !crossing;
-                }
-            }
-            if area <= 0.0 {
-                return true;
-            }
-            inside |= crossing;
-        }
-        inside
     }
 
     /// Whether the master cannot move (all its nodes fixed: infinite mass, 1/m = 0).
@@ -204,12 +151,8 @@ impl Detector<'_> {
                 let xi = f.xi(xs);
                 let (na, nb) = (1.0 - xi, xi);
                 let dn = dot(sub(xs, f.point(na, nb)), f.n);
-                // Active if 0 ≤ ξ ≤ 1 and the particle is not beyond the far side, (x_s − x_c)·n > −d_max. Behind
-                // the segment (dn < 0) it must also be inside the structure: a structure thinner than d_max − r_c
-                // (the elastic gate, 5 mm, at Δx ≥ 5 mm) has particles resting r_c in front of one face within d_max
-                // behind the opposite one, and those are outside, not through that face. A particle that did pass
-                // through a face is inside (it moves less than Δx/4 a step), so real penetrations are unaffected.
-                let inside = (0.0..=1.0).contains(&xi) && dn > -self.far_side && (dn >= 0.0 || self.may_be_inside(xs));
+                // Active if 0 ≤ ξ ≤ 1 and the particle is not beyond the far side, (x_s − x_c)·n > −d_max.
+                let inside = (0.0..=1.0).contains(&xi) && dn > -self.far_side;
                 let hit = Hit {
                     a: s.a,
                     b: s.b,
