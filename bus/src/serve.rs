@@ -7,7 +7,7 @@ use std::time::Duration;
 use anyhow::Context;
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic, NodeTopics};
-use cosim_proto::messages::{NodeError, StepCommand};
+use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
 use cosim_proto::scene::Scene;
 use serde::Serialize;
 use zenoh::qos::CongestionControl;
@@ -64,6 +64,20 @@ pub trait NodeCore {
     /// Sizes for the live status (particles, nodes, elements, …).
     fn counts(&self) -> Vec<(&'static str, u64)> {
         Vec::new()
+    }
+
+    /// The node's whole state between two steps, for a checkpoint (`docs/PROTOCOL.md` §9); `None` for a node
+    /// that cannot save one.
+    fn checkpoint(&self) -> Option<Vec<u8>> {
+        None
+    }
+
+    /// Continue from the bytes [`NodeCore::checkpoint`] gave, on a node built from the same scene.
+    fn restore(&mut self, _data: &[u8]) -> Result<(), Failure> {
+        Err(Failure {
+            unstable: false,
+            message: "this node cannot continue from a checkpoint".into(),
+        })
     }
 }
 
@@ -149,9 +163,29 @@ fn serve_session<C: NodeCore>(
         .wait()
         .map_err(zerr)?;
 
-    let scene_text = fetch_scene(session, run, Duration::from_millis(opts.timeout_ms))?;
+    // The broker asks for this node's state between two steps when it writes a checkpoint.
+    let checkpoints = session
+        .declare_queryable(key(run, topics.checkpoint))
+        .wait()
+        .map_err(zerr)?;
+
+    let timeout = Duration::from_millis(opts.timeout_ms);
+    let scene_text = fetch_scene(session, run, timeout)?;
     let scene = cosim_proto::scene::parse("(scene from the broker)", &scene_text, &[])?;
     let mut core = build(&scene)?;
+    // A restarted run: continue from the state the broker hands out, after the step it was saved at.
+    let mut expected = 0u64;
+    let mut t = 0.0;
+    if let Some(saved) = fetch_restore(session, run, topics, timeout)? {
+        core.restore(&saved.body.data)
+            .map_err(|e| anyhow::anyhow!("cannot restart from the checkpoint: {e}"))?;
+        expected = saved.step + 1;
+        t = saved.t;
+        board.update(|s| {
+            s.step = saved.step;
+            s.t = saved.t;
+        });
+    }
     board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
     let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
     session
@@ -160,11 +194,26 @@ fn serve_session<C: NodeCore>(
         .wait()
         .map_err(zerr)?;
 
-    let mut expected = 0u64;
-    let mut t = 0.0;
     let mut idle_since = std::time::Instant::now();
     loop {
-        let Some(sample) = commands.recv_timeout(Duration::from_millis(200)).map_err(zerr)? else {
+        while let Ok(Some(query)) = checkpoints.try_recv() {
+            // Between two steps: the state after step `expected - 1`, before the corrections of the next.
+            let reply = match core.checkpoint() {
+                Some(data) => {
+                    let body = NodeCheckpoint {
+                        node: topics.name.into(),
+                        data,
+                    };
+                    let bytes = Envelope::new(run, expected.saturating_sub(1), t, body).encode();
+                    query.reply(query.key_expr().clone(), bytes).wait()
+                }
+                None => query.reply_err("this node cannot save a checkpoint").wait(),
+            };
+            if let Err(e) = reply {
+                tracing::error!("checkpoint query: {e}");
+            }
+        }
+        let Some(sample) = commands.recv_timeout(Duration::from_millis(50)).map_err(zerr)? else {
             while let Ok(Some(s)) = broker_alive.try_recv() {
                 if s.kind() == SampleKind::Delete {
                     anyhow::bail!("the broker of run {run} went away");
@@ -205,6 +254,39 @@ fn serve_session<C: NodeCore>(
             .wait()
             .map_err(zerr)?;
     }
+}
+
+/// The state to restart from, when the broker has one for this node (`docs/PROTOCOL.md` §9): `None` for a run
+/// that starts from the scene.
+fn fetch_restore(
+    session: &Session,
+    run: &str,
+    topics: NodeTopics,
+    timeout: Duration,
+) -> anyhow::Result<Option<Envelope<NodeCheckpoint>>> {
+    let replies = session
+        .get(key(run, topics.restore))
+        .timeout(timeout)
+        .wait()
+        .map_err(zerr)?;
+    let Ok(reply) = replies.recv() else {
+        anyhow::bail!(
+            "the broker of run {run} did not answer {} within {:.0} s",
+            topics.restore,
+            timeout.as_secs_f64()
+        );
+    };
+    let sample = reply
+        .result()
+        .map_err(|e| anyhow::anyhow!("the broker refused the {} query: {e:?}", topics.restore))?;
+    let env = Envelope::<NodeCheckpoint>::decode(&sample.payload().to_bytes(), run, topics.restore)?;
+    anyhow::ensure!(
+        env.body.node == topics.name,
+        "the broker offered a {} state to restart this {} from",
+        env.body.node,
+        topics.name
+    );
+    Ok((!env.body.data.is_empty()).then_some(env))
 }
 
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {

@@ -8,9 +8,10 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use cosim_proto::messages::{FemState, SphSnapshot, SphState, StepCommand};
+use cosim_proto::messages::{FemMesh, FemState, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{LoadedScene, SceneError};
 
+use crate::checkpoint::{self, BrokerState};
 use crate::interface::{Corrections, Interface, PassStats};
 use crate::link::{FemLink, LinkError, Reply, SphLink};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, PointField, ProbeCsv};
@@ -77,8 +78,28 @@ pub struct Nodes<'a> {
     pub sph: Option<&'a mut SphLink>,
 }
 
+/// Checkpoints to write, and the one to continue from.
+#[derive(Debug, Default)]
+pub struct Checkpoints {
+    /// Write `DIR/checkpoints/<step>/` at the first step at or after every multiple of this simulated time [s].
+    pub interval: Option<f64>,
+    /// Continue from this checkpoint's coordinator state (the nodes were given theirs when they started).
+    pub restart: Option<BrokerState>,
+}
+
 /// Run a scene to its end time (or to the first failure) and write every output.
-pub fn run(scene: &LoadedScene, mut nodes: Nodes<'_>, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
+pub fn run(scene: &LoadedScene, nodes: Nodes<'_>, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
+    run_with(scene, nodes, info, &Checkpoints::default(), progress)
+}
+
+/// [`run`], writing checkpoints or continuing from one.
+pub fn run_with(
+    scene: &LoadedScene,
+    mut nodes: Nodes<'_>,
+    info: &RunInfo,
+    plan: &Checkpoints,
+    progress: &mut dyn FnMut(Progress),
+) -> Outcome {
     let started = Instant::now();
     let s = &scene.scene;
     let (fem_nodes, fem_elements) = nodes
@@ -114,7 +135,7 @@ pub fn run(scene: &LoadedScene, mut nodes: Nodes<'_>, info: &RunInfo, progress: 
         contact_stats: ContactStats::default(),
     };
     let mut series = Vec::new();
-    let error = drive(scene, &mut nodes, info, progress, &mut summary, &mut series).err();
+    let error = drive(scene, &mut nodes, info, plan, progress, &mut summary, &mut series).err();
     // Whatever happened, the probes computed so far are plotted and the summary is written.
     let t_plot = Instant::now();
     if let Err(e) = plot_all(scene, &info.out, &series) {
@@ -150,12 +171,13 @@ fn drive(
     scene: &LoadedScene,
     nodes: &mut Nodes<'_>,
     info: &RunInfo,
+    plan: &Checkpoints,
     progress: &mut dyn FnMut(Progress),
     summary: &mut Summary,
     series: &mut Series,
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
-    let mut probes = Probes::resolve(
+    let probes = Probes::resolve(
         s,
         nodes.fem.as_ref().map(|f| f.setup()),
         nodes.sph.as_ref().map(|n| n.setup()),
@@ -163,48 +185,25 @@ fn drive(
     .map_err(anyhow::Error::msg)?;
     *series = vec![Vec::new(); probes.names().len()];
     // Frames are encoded and written on their own thread (output/queue.rs), from the snapshots handed over.
-    let mut frames = FrameQueue::new(FrameWriter::new(&info.out)?)?;
+    let writer = match &plan.restart {
+        Some(saved) => FrameWriter::resume(&info.out, &saved.rows.iter().map(|r| r.0).collect::<Vec<_>>())?,
+        None => FrameWriter::new(&info.out)?,
+    };
+    let frames = FrameQueue::new(writer)?;
     let mesh = nodes.fem.as_ref().map(|f| Arc::new(f.setup().clone()));
     let walls = nodes.sph.as_ref().map(|n| Arc::new(n.setup().walls.clone()));
     let density = nodes.sph.as_ref().map_or(0.0, |n| n.setup().density);
-    let mut csv = ProbeCsv::create(&info.out.join("probes.csv"), probes.names())?;
+    let csv = ProbeCsv::create(&info.out.join("probes.csv"), probes.names())?;
     let interval = s.run.output_interval;
     let end = s.run.end_time;
-    let mut sample = |t: f64,
-                      round: &mut Round,
-                      nodes: &Nodes<'_>,
-                      load: Option<&[[f64; 2]]>,
-                      summary: &mut Summary|
-     -> anyhow::Result<()> {
-        let started = Instant::now();
-        let fem = match (&nodes.fem, &round.fem) {
-            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "fem-node")?)),
-            _ => None,
-        };
-        let sph = match (&nodes.sph, &round.sph) {
-            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "sph-node")?)),
-            _ => None,
-        };
-        let values = probes.sample(fem, sph);
-        csv.push(t, &values)?;
-        for (line, v) in series.iter_mut().zip(&values) {
-            line.push((t, *v));
-        }
-        let index = summary.frames as usize;
-        if let (Some(mesh), Some(snap)) = (&mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
-            let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
-            frames.push(Box::new(move |w| {
-                w.write_structure(index, t, &mesh, &snap, load.as_deref()).map(drop)
-            }))?;
-        }
-        if let (Some(walls), Some(snap)) = (&walls, round.sph.as_mut().and_then(|s| s.snapshot.take())) {
-            let walls = Arc::clone(walls);
-            frames.push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
-        }
-        summary.frames += 1;
-        summary.samples += 1;
-        summary.timings.broker += started.elapsed().as_secs_f64();
-        Ok(())
+    let mut out = Outputs {
+        probes,
+        csv,
+        frames,
+        series,
+        mesh,
+        walls,
+        density,
     };
 
     // DESIGN.md §3: with both a structure and a fluid the broker runs the contact pass between steps.
@@ -224,10 +223,46 @@ fn drive(
     let mut t = 0.0;
     let mut step = 0u64;
     let coupled = interface.is_some();
-    let mut round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
-    sample(t, &mut round, nodes, load.as_deref(), summary)?;
     let mut dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
     let mut next_output = 1u64;
+    let mut next_checkpoint = 1u64;
+    match &plan.restart {
+        // Continue where the checkpoint left off: the nodes restored their own states when they started.
+        Some(saved) => {
+            (t, step, next_output, next_checkpoint, dt_fluid) = (
+                saved.t,
+                saved.step,
+                saved.next_output,
+                saved.next_checkpoint,
+                saved.dt_fluid,
+            );
+            pending = Corrections {
+                fem: saved.pending_fem.clone(),
+                sph: saved.pending_sph.clone(),
+            };
+            (roi, load, exchanged) = (saved.roi, saved.load.clone(), saved.exchanged);
+            out.probes.set_fluid_origin(saved.fluid_origin.clone());
+            for (t, values) in &saved.rows {
+                out.csv.push(*t, values)?;
+                for (line, v) in out.series.iter_mut().zip(values) {
+                    line.push((*t, *v));
+                }
+            }
+            let s = &saved.summary;
+            summary.steps = s.steps;
+            summary.fem_substeps = s.fem_substeps;
+            summary.sph_substeps = s.sph_substeps;
+            summary.sim_time = s.sim_time;
+            summary.frames = s.frames;
+            summary.samples = s.samples;
+            summary.timings = s.timings.clone();
+            summary.contact_stats = s.contact_stats.clone();
+        }
+        None => {
+            let mut round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
+            out.sample(t, &mut round, nodes, load.as_deref(), summary)?;
+        }
+    }
     while t < end {
         let target = (next_output as f64 * interval).min(end);
         // §3 step 1: the coupling step is the fluid's stable step, capped by the user and the next output time.
@@ -270,12 +305,36 @@ fn drive(
             summary.timings.broker += started.elapsed().as_secs_f64();
         }
         if lands {
-            sample(t, &mut round, nodes, load.as_deref(), summary)?;
+            out.sample(t, &mut round, nodes, load.as_deref(), summary)?;
             if target >= next_output as f64 * interval {
                 next_output += 1;
             }
         }
         progress(Progress { step, t, end_time: end });
+        // Between two steps: every node answered `step`, its corrections are still to be sent.
+        if let Some(interval) = plan.interval {
+            if t >= next_checkpoint as f64 * interval - LANDING * cap {
+                while t >= next_checkpoint as f64 * interval - LANDING * cap {
+                    next_checkpoint += 1;
+                }
+                let state = BrokerState {
+                    step,
+                    t,
+                    next_output,
+                    next_checkpoint,
+                    dt_fluid,
+                    pending_fem: pending.fem.clone(),
+                    pending_sph: pending.sph.clone(),
+                    roi,
+                    load: load.clone(),
+                    exchanged,
+                    fluid_origin: out.probes.fluid_origin().map(<[_]>::to_vec),
+                    rows: out.csv.rows().to_vec(),
+                    summary: summary.clone(),
+                };
+                save_checkpoint(scene, nodes, info, &state)?;
+            }
+        }
     }
     let stop = command(0.0, false, true);
     if let Some(link) = nodes.fem.as_deref_mut() {
@@ -286,9 +345,91 @@ fn drive(
     }
     // The frames still being written count as the broker's time.
     let started = Instant::now();
-    let written = frames.finish();
+    let written = out.frames.finish();
     summary.timings.broker += started.elapsed().as_secs_f64();
     written?;
+    Ok(())
+}
+
+/// The run's outputs: the probes and `probes.csv`, the frames (written on their own thread, `output/queue.rs`),
+/// and the probe series for the plots.
+struct Outputs<'s> {
+    probes: Probes,
+    csv: ProbeCsv,
+    frames: FrameQueue,
+    series: &'s mut Series,
+    mesh: Option<Arc<FemMesh>>,
+    walls: Option<Arc<Vec<[f64; 2]>>>,
+    density: f64,
+}
+
+impl Outputs<'_> {
+    /// Sample the probes and write the frames of an output time, from the snapshots of `round`.
+    fn sample(
+        &mut self,
+        t: f64,
+        round: &mut Round,
+        nodes: &Nodes<'_>,
+        load: Option<&[[f64; 2]]>,
+        summary: &mut Summary,
+    ) -> anyhow::Result<()> {
+        let started = Instant::now();
+        let fem = match (&nodes.fem, &round.fem) {
+            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "fem-node")?)),
+            _ => None,
+        };
+        let sph = match (&nodes.sph, &round.sph) {
+            (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "sph-node")?)),
+            _ => None,
+        };
+        let values = self.probes.sample(fem, sph);
+        self.csv.push(t, &values)?;
+        for (line, v) in self.series.iter_mut().zip(&values) {
+            line.push((t, *v));
+        }
+        let index = summary.frames as usize;
+        if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
+            let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
+            self.frames.push(Box::new(move |w| {
+                w.write_structure(index, t, &mesh, &snap, load.as_deref()).map(drop)
+            }))?;
+        }
+        if let (Some(walls), Some(snap)) = (&self.walls, round.sph.as_mut().and_then(|s| s.snapshot.take())) {
+            let (walls, density) = (Arc::clone(walls), self.density);
+            self.frames
+                .push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
+        }
+        summary.frames += 1;
+        summary.samples += 1;
+        summary.timings.broker += started.elapsed().as_secs_f64();
+        Ok(())
+    }
+}
+
+/// Gather every node's state and write the checkpoint folder. A node that cannot save its state fails the run:
+/// asked for checkpoints, the user must not find out at the restart that there are none.
+fn save_checkpoint(
+    scene: &LoadedScene,
+    nodes: &mut Nodes<'_>,
+    info: &RunInfo,
+    state: &BrokerState,
+) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let context = || format!("checkpoint at step {} (t = {} s)", state.step, state.t);
+    let mut saved = Vec::new();
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        saved.push(("fem", link.checkpoint(state.step).with_context(context)?));
+    }
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        saved.push(("sph", link.checkpoint(state.step).with_context(context)?));
+    }
+    let written = checkpoint::write(&info.out, &info.run_id, scene, state, &saved, started).with_context(context)?;
+    tracing::info!(
+        "checkpoint {}: {} bytes in {:.3} s",
+        written.dir.display(),
+        written.bytes,
+        written.seconds
+    );
     Ok(())
 }
 

@@ -23,7 +23,7 @@ pub struct PassStats {
 }
 
 /// The corrections of one pass, per node.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Corrections {
     /// To the structure node (FE node ids).
     pub fem: Vec<Correction>,

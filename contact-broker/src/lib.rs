@@ -4,6 +4,7 @@
 //! adapter used by the `contact-broker` binary.
 #![warn(missing_docs)]
 
+pub mod checkpoint;
 pub mod contact;
 pub mod coordinator;
 pub mod interface;

@@ -77,6 +77,10 @@ pub trait NodeLink {
     fn concurrent(&self) -> bool {
         true
     }
+
+    /// The node's whole state after the last step it answered, in its own format, for a checkpoint
+    /// (`docs/PROTOCOL.md` §9). Asked for only between two steps.
+    fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError>;
 }
 
 /// The structure node.
@@ -86,11 +90,14 @@ pub type SphLink = dyn NodeLink<Setup = SphSetup, State = SphState>;
 
 /// A node's step handler: the answer to a command, `None` for a stop.
 type Handler<T> = Box<dyn FnMut(&StepCommand) -> Result<Option<T>, LinkError>>;
+/// A node's checkpoint: its state between two steps.
+type Saver = Box<dyn FnMut() -> Result<Vec<u8>, LinkError>>;
 
 /// A node in this process: a handler called when its answer is asked for.
 pub struct InProcess<S, T> {
     setup: S,
     handler: Handler<T>,
+    saver: Option<Saver>,
     pending: Option<StepCommand>,
 }
 
@@ -100,8 +107,15 @@ impl<S, T> InProcess<S, T> {
         Self {
             setup,
             handler: Box::new(handler),
+            saver: None,
             pending: None,
         }
+    }
+
+    /// The node can save its state for a checkpoint with `saver`.
+    pub fn with_checkpoint(mut self, saver: impl FnMut() -> Result<Vec<u8>, LinkError> + 'static) -> Self {
+        self.saver = Some(Box::new(saver));
+        self
     }
 }
 
@@ -135,5 +149,15 @@ impl<S, T: Reply> NodeLink for InProcess<S, T> {
 
     fn concurrent(&self) -> bool {
         false
+    }
+
+    fn checkpoint(&mut self, _step: u64) -> Result<Vec<u8>, LinkError> {
+        match &mut self.saver {
+            Some(save) => save(),
+            None => Err(LinkError::Failed {
+                node: "in-process node".into(),
+                message: "cannot save a checkpoint".into(),
+            }),
+        }
     }
 }

@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
+use contact_broker::checkpoint;
 use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
 use contact_broker::transport::{self, ZenohLink};
@@ -45,6 +46,12 @@ struct Args {
     /// Seconds to wait for the nodes to register.
     #[arg(long, default_value_t = 60.0)]
     wait_nodes: f64,
+    /// Write a checkpoint (`DIR/checkpoints/<step>/`) every this many seconds of simulated time.
+    #[arg(long, value_name = "SECONDS")]
+    checkpoint_interval: Option<f64>,
+    /// Continue from this checkpoint folder (`DIR/checkpoints/<step>`) instead of from the scene.
+    #[arg(long, value_name = "DIR")]
+    restart: Option<PathBuf>,
     /// Mode written into summary.json.
     #[arg(long, default_value = "processes")]
     mode: String,
@@ -75,6 +82,16 @@ fn run(args: Args) -> anyhow::Result<()> {
     );
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
     coordinator::check_supported(&scene)?;
+    if let Some(i) = args.checkpoint_interval {
+        anyhow::ensure!(
+            i.is_finite() && i > 0.0,
+            "--checkpoint-interval must be a positive number of seconds, got {i}"
+        );
+    }
+    let restart = match &args.restart {
+        Some(dir) => Some(checkpoint::open(dir, &scene)?),
+        None => None,
+    };
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let (session, endpoints) = match args.client {
         true => transport::open_client(&args.connect, 5000)
@@ -97,6 +114,25 @@ fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
+    // Each node asks, once it has the scene, whether it continues from a saved state.
+    let saved = |data: Option<&Vec<u8>>| {
+        let r = restart.as_ref()?;
+        Some((r.broker.step, r.broker.t, data?.clone()))
+    };
+    let _restore = (
+        transport::serve_restore(
+            &session,
+            &args.run,
+            cosim_proto::keys::FEM,
+            saved(restart.as_ref().and_then(|r| r.fem.as_ref())),
+        )?,
+        transport::serve_restore(
+            &session,
+            &args.run,
+            cosim_proto::keys::SPH,
+            saved(restart.as_ref().and_then(|r| r.sph.as_ref())),
+        )?,
+    );
     let _alive = session
         .liveliness()
         .declare_token(key(&args.run, topic::BROKER_ALIVE))
@@ -160,7 +196,11 @@ fn run(args: Args) -> anyhow::Result<()> {
             emit(serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time}));
         }
     };
-    let outcome = coordinator::run(&scene, nodes, &info, &mut report);
+    let plan = coordinator::Checkpoints {
+        interval: args.checkpoint_interval,
+        restart: restart.map(|r| r.broker),
+    };
+    let outcome = coordinator::run_with(&scene, nodes, &info, &plan, &mut report);
     board.update(|s| {
         s.health = if outcome.summary.status == "ok" {
             "finished"

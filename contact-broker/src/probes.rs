@@ -34,6 +34,16 @@ pub struct Probes {
 }
 
 impl Probes {
+    /// Fluid positions of the first sample, once taken (a checkpoint keeps them).
+    pub fn fluid_origin(&self) -> Option<&[[f64; 2]]> {
+        self.fluid_x0.as_deref()
+    }
+
+    /// Continue with the first sample's fluid positions of a checkpoint.
+    pub fn set_fluid_origin(&mut self, x0: Option<Vec<[f64; 2]>>) {
+        self.fluid_x0 = x0;
+    }
+
     /// Resolve every probe (nearest node in the reference configuration, solid indices).
     pub fn resolve(scene: &Scene, mesh: Option<&FemMesh>, fluid: Option<&SphSetup>) -> Result<Self, String> {
         let mut resolved = Vec::with_capacity(scene.probes.len());

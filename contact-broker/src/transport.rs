@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use cosim_proto::envelope::{CodecError, Envelope};
 use cosim_proto::keys::{key, topic, NodeTopics};
-use cosim_proto::messages::{NodeError, StepCommand};
+use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
 use serde::de::DeserializeOwned;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
@@ -25,6 +25,32 @@ pub fn serve_scene(session: &Session, run: &str, scene_toml: String) -> anyhow::
         .callback(move |query| {
             if let Err(e) = query.reply(query.key_expr().clone(), scene_toml.clone()).wait() {
                 tracing::warn!("scene query: {e}");
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// Answer `cosim/<run>/<node>/restore` (`docs/PROTOCOL.md` §9) for as long as the returned handle lives: the
+/// node's state saved at step `step` (time `t`) when the run continues from a checkpoint, else an empty state
+/// (start from the scene).
+pub fn serve_restore(
+    session: &Session,
+    run: &str,
+    topics: NodeTopics,
+    saved: Option<(u64, f64, Vec<u8>)>,
+) -> anyhow::Result<Queryable<()>> {
+    let (step, t, data) = saved.unwrap_or((0, 0.0, Vec::new()));
+    let body = NodeCheckpoint {
+        node: topics.name.into(),
+        data,
+    };
+    let bytes = Envelope::new(run, step, t, body).encode();
+    session
+        .declare_queryable(key(run, topics.restore))
+        .callback(move |query| {
+            if let Err(e) = query.reply(query.key_expr().clone(), bytes.clone()).wait() {
+                tracing::warn!("restore query: {e}");
             }
         })
         .wait()
@@ -66,6 +92,7 @@ pub fn subscribe(session: &Session, run: &str, topics: NodeTopics) -> anyhow::Re
 
 /// A node in another process.
 pub struct ZenohLink<S, T> {
+    session: Session,
     run: String,
     topics: NodeTopics,
     setup: S,
@@ -146,6 +173,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             .wait()
             .map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(Self {
+            session: session.clone(),
             run: run.to_string(),
             topics,
             setup,
@@ -201,6 +229,32 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             .put(bytes)
             .wait()
             .map_err(|e| self.failed(format!("cannot send step {step}: {e}")))
+    }
+
+    fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
+        let what = self.topics.checkpoint;
+        let replies = self
+            .session
+            .get(key(&self.run, what))
+            .timeout(self.step_timeout)
+            .wait()
+            .map_err(|e| self.failed(format!("cannot ask for a checkpoint: {e}")))?;
+        let reply = replies.recv().map_err(|_| {
+            self.failed(format!(
+                "did not answer {what} within {:.0} s (an outside program in a node's place may not save checkpoints)",
+                self.step_timeout.as_secs_f64()
+            ))
+        })?;
+        let sample = reply
+            .result()
+            .map_err(|e| self.failed(format!("refused the checkpoint: {:?}", e.payload().try_to_string())))?;
+        let env = Envelope::<NodeCheckpoint>::decode(&sample.payload().to_bytes(), &self.run, what)
+            .and_then(|e| e.expect_step(step, what))
+            .map_err(|e| self.failed(format!("sent an unusable checkpoint: {e}")))?;
+        if env.body.node != self.topics.name {
+            return Err(self.failed(format!("sent a checkpoint of a {}", env.body.node)));
+        }
+        Ok(env.body.data)
     }
 
     fn receive(&mut self, step: u64) -> Result<T, LinkError> {

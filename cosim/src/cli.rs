@@ -65,6 +65,14 @@ pub struct RunArgs {
     /// Seconds to wait for the external node to register (with `--external`).
     #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
     pub wait_external: f64,
+    /// Write a checkpoint, `DIR/checkpoints/<step>/` (every node's state, the broker's, the scene), every this
+    /// many seconds of simulated time.
+    #[arg(long, value_name = "SECONDS")]
+    pub checkpoint_interval: Option<f64>,
+    /// Continue from a checkpoint folder, `DIR/checkpoints/<step>`, instead of from the start: the scene must be
+    /// the one it was written with (only `run.end_time` may differ).
+    #[arg(long, value_name = "CHECKPOINT")]
+    pub restart: Option<PathBuf>,
 }
 
 /// A node an outside program can take the place of.

@@ -1,8 +1,11 @@
 //! Every node in this process: the coordinator calls the nodes' handlers directly — the same handlers the node
 //! binaries serve over zenoh (`cosim_bus::serve::NodeCore`).
 
+use std::cell::RefCell;
+use std::rc::Rc;
+
 use contact_broker::link::{InProcess, LinkError, Reply};
-use cosim_bus::serve::NodeCore;
+use cosim_bus::serve::{Failure, NodeCore};
 
 /// A node, in this process; `name` labels its errors.
 pub fn link<C>(name: &'static str, core: C) -> InProcess<C::Setup, C::State>
@@ -12,17 +15,22 @@ where
     C::State: Reply,
 {
     let setup = core.setup().clone();
-    let mut core = core;
-    InProcess::new(setup, move |cmd| {
-        core.handle(cmd).map_err(|f| match f.unstable {
-            true => LinkError::Unstable {
-                node: name.into(),
-                message: f.message,
-            },
-            false => LinkError::Failed {
-                node: name.into(),
-                message: f.message,
-            },
+    let error = move |f: Failure| match f.unstable {
+        true => LinkError::Unstable {
+            node: name.into(),
+            message: f.message,
+        },
+        false => LinkError::Failed {
+            node: name.into(),
+            message: f.message,
+        },
+    };
+    let core = Rc::new(RefCell::new(core));
+    let saving = Rc::clone(&core);
+    InProcess::new(setup, move |cmd| core.borrow_mut().handle(cmd).map_err(error)).with_checkpoint(move || {
+        saving.borrow().checkpoint().ok_or_else(|| LinkError::Failed {
+            node: name.into(),
+            message: "cannot save a checkpoint".into(),
         })
     })
 }

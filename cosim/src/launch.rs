@@ -164,6 +164,12 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if args.external.is_some() {
         broker_args.extend(["--wait-nodes".into(), args.wait_external.to_string()]);
     }
+    if let Some(i) = args.checkpoint_interval {
+        broker_args.extend(["--checkpoint-interval".into(), i.to_string()]);
+    }
+    if let Some(dir) = &args.restart {
+        broker_args.extend(["--restart".into(), dir.display().to_string()]);
+    }
     let mut broker = spawn("contact-broker", &broker_bin, &broker_args, &broker_log, Stdio::piped())?;
     let (tx, rx) = mpsc::channel();
     let stdout = broker.child.stdout.take().expect("piped stdout");

@@ -4,7 +4,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use contact_broker::coordinator::{self, Nodes, RunInfo};
+use contact_broker::checkpoint::{self, Restart};
+use contact_broker::coordinator::{self, Checkpoints, Nodes, RunInfo};
 use contact_broker::link::{FemLink, SphLink};
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{self, LoadedScene};
@@ -54,11 +55,32 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             args.wait_external
         );
     }
+    if let Some(i) = args.checkpoint_interval {
+        anyhow::ensure!(
+            i.is_finite() && i > 0.0,
+            "--checkpoint-interval must be a positive number of seconds, got {i}"
+        );
+    }
+    if let (Some(node), true) = (
+        args.external,
+        args.checkpoint_interval.is_some() || args.restart.is_some(),
+    ) {
+        anyhow::bail!(
+            "--external {}: checkpoints and restarts need every node's state, which an outside program does not \
+             save (drop --checkpoint-interval and --restart)",
+            node.name()
+        );
+    }
+    // Checked here, before anything is cleared or started: the wrong checkpoint is bad input (exit 2).
+    let restart = match &args.restart {
+        Some(dir) => Some(checkpoint::open(dir, &scene)?),
+        None => None,
+    };
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
-    prepare_out(&out, &scene)?;
+    prepare_out(&out, &scene, restart.is_some())?;
     let info = RunInfo {
         run_id,
         mode: if args.in_process { "in-process" } else { "processes" }.into(),
@@ -66,7 +88,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     };
     let bar = Bar::new(args.quiet);
     let result = if args.in_process {
-        run_in_process(args, &scene, &info, &bar)
+        run_in_process(args, &scene, &info, restart, &bar)
     } else {
         launch::run_processes(args, &scene.scene, &info, &bar)
     };
@@ -103,10 +125,17 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Create the folder, clear the outputs of an earlier run there, and keep the resolved scene beside them.
-fn prepare_out(out: &Path, scene: &LoadedScene) -> anyhow::Result<()> {
+/// Create the folder, clear the outputs of an earlier run there, and keep the resolved scene beside them. A
+/// restart keeps the frames: restarted into the folder of the run it continues, the frames before the checkpoint
+/// stay (and stay listed in the `.pvd` collections); the later ones are written again.
+fn prepare_out(out: &Path, scene: &LoadedScene, restart: bool) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
-    for stale in ["frames", "plots", "logs"] {
+    let stale_dirs: &[&str] = if restart {
+        &["plots", "logs"]
+    } else {
+        &["frames", "plots", "logs"]
+    };
+    for stale in stale_dirs {
         let dir = out.join(stale);
         if dir.exists() {
             std::fs::remove_dir_all(&dir).with_context(|| format!("cannot clear {}", dir.display()))?;
@@ -124,30 +153,43 @@ fn run_in_process(
     args: &RunArgs,
     scene: &LoadedScene,
     info: &RunInfo,
+    restart: Option<Restart>,
     bar: &Bar,
 ) -> anyhow::Result<contact_broker::summary::Summary> {
     if let Some(n) = args.threads {
         rayon_threads(n)?;
     }
     let mut fem = match scene.scene.solids.is_empty() {
-        false => Some(in_process::link(
-            "fem-node",
-            FemCore::new(&scene.scene).context("fem-node")?,
-        )),
+        false => {
+            let mut core = FemCore::new(&scene.scene).context("fem-node")?;
+            if let Some(data) = restart.as_ref().and_then(|r| r.fem.as_ref()) {
+                core.restore(data)
+                    .context("fem-node: cannot restart from the checkpoint")?;
+            }
+            Some(in_process::link("fem-node", core))
+        }
         true => None,
     };
     let mut sph = match scene.scene.fluid {
-        Some(_) => Some(in_process::link(
-            "sph-node",
-            SphCore::new(&scene.scene).context("sph-node")?,
-        )),
+        Some(_) => {
+            let mut core = SphCore::new(&scene.scene).context("sph-node")?;
+            if let Some(data) = restart.as_ref().and_then(|r| r.sph.as_ref()) {
+                core.restore(data)
+                    .context("sph-node: cannot restart from the checkpoint")?;
+            }
+            Some(in_process::link("sph-node", core))
+        }
         None => None,
     };
     let nodes = Nodes {
         fem: fem.as_mut().map(|l| l as &mut FemLink),
         sph: sph.as_mut().map(|l| l as &mut SphLink),
     };
-    let outcome = coordinator::run(scene, nodes, info, &mut |p| bar.update(p));
+    let plan = Checkpoints {
+        interval: args.checkpoint_interval,
+        restart: restart.map(|r| r.broker),
+    };
+    let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| bar.update(p));
     Ok(outcome.summary)
 }
 

@@ -9,6 +9,10 @@ use cosim_proto::scene::Scene;
 use crate::error::FemError;
 use crate::model::FemModel;
 use crate::solver::FemSolver;
+use crate::state::FemState as SolverState;
+
+/// Tag and format version at the head of a structure node's checkpoint (`docs/PROTOCOL.md` §9).
+const CHECKPOINT_TAG: (&str, u32) = ("cosim-fem-checkpoint", 1);
 
 /// A structure node: the solver plus what it tells the broker.
 pub struct FemCore {
@@ -39,6 +43,32 @@ impl FemCore {
     /// The solver (tests, checkpoints).
     pub fn solver(&self) -> &FemSolver {
         &self.solver
+    }
+
+    /// The node's state between two steps, for a checkpoint: the solver state (positions, velocities,
+    /// accelerations, time, sub-step count) and whether its accelerations are stale. The model is not saved:
+    /// it follows from the scene, which the checkpoint keeps.
+    pub fn checkpoint(&self) -> Vec<u8> {
+        let tag = CHECKPOINT_TAG;
+        let saved = (tag.0, tag.1, self.solver.state(), self.solver.accelerations_stale());
+        bincode::serialize(&saved).expect("in-memory bincode encoding of plain data")
+    }
+
+    /// Continue from [`FemCore::checkpoint`]'s bytes, on a core built from the same scene.
+    pub fn restore(&mut self, data: &[u8]) -> Result<(), FemError> {
+        let invalid = |message: String| FemError::InvalidParameter {
+            name: "checkpoint",
+            message,
+        };
+        let (tag, version, state, stale): (String, u32, SolverState, bool) =
+            bincode::deserialize(data).map_err(|e| invalid(format!("not a structure node's state: {e}")))?;
+        if (tag.as_str(), version) != CHECKPOINT_TAG {
+            return Err(invalid(format!(
+                "holds `{tag}` version {version}, this fem-node reads `{}` version {}",
+                CHECKPOINT_TAG.0, CHECKPOINT_TAG.1
+            )));
+        }
+        self.solver.resume(state, stale)
     }
 
     /// Apply the corrections, advance by `dt`, and answer. `None` for a stop command.

@@ -35,4 +35,12 @@ impl NodeCore for FemCore {
             ("interface_segments", m.interface.len() as u64),
         ]
     }
+
+    fn checkpoint(&self) -> Option<Vec<u8>> {
+        Some(FemCore::checkpoint(self))
+    }
+
+    fn restore(&mut self, data: &[u8]) -> Result<(), Failure> {
+        FemCore::restore(self, data).map_err(Failure::from)
+    }
 }

@@ -32,6 +32,14 @@ pub mod topic {
     pub const BROKER_STATUS: &str = "broker/status";
     /// Status queryable of the SPH node.
     pub const SPH_STATUS: &str = "sph/status";
+    /// Checkpoint queryable of the FEM node: its state between two steps, for `DIR/checkpoints/` (broker asks).
+    pub const FEM_CHECKPOINT: &str = "fem/checkpoint";
+    /// Checkpoint queryable of the SPH node.
+    pub const SPH_CHECKPOINT: &str = "sph/checkpoint";
+    /// Broker queryable: the state the FEM node restarts from (node asks, once, after the scene).
+    pub const FEM_RESTORE: &str = "fem/restore";
+    /// Broker queryable: the state the SPH node restarts from.
+    pub const SPH_RESTORE: &str = "sph/restore";
     /// Every status queryable of a run (`cosim/<run>/*/status`).
     pub const ANY_STATUS: &str = "*/status";
 }
@@ -72,6 +80,10 @@ pub struct NodeTopics {
     pub alive: &'static str,
     /// Live status queryable.
     pub status: &'static str,
+    /// Checkpoint queryable (served by the node).
+    pub checkpoint: &'static str,
+    /// Restart state queryable (served by the broker).
+    pub restore: &'static str,
 }
 
 /// The structure node's topics.
@@ -83,6 +95,8 @@ pub const FEM: NodeTopics = NodeTopics {
     command: topic::BROKER_FEM,
     alive: topic::FEM_ALIVE,
     status: topic::FEM_STATUS,
+    checkpoint: topic::FEM_CHECKPOINT,
+    restore: topic::FEM_RESTORE,
 };
 
 /// The fluid node's topics.
@@ -94,4 +108,6 @@ pub const SPH: NodeTopics = NodeTopics {
     command: topic::BROKER_SPH,
     alive: topic::SPH_ALIVE,
     status: topic::SPH_STATUS,
+    checkpoint: topic::SPH_CHECKPOINT,
+    restore: topic::SPH_RESTORE,
 };

@@ -184,3 +184,15 @@ pub struct SphState {
     /// Full snapshot when asked for.
     pub snapshot: Option<SphSnapshot>,
 }
+
+/// Topics `fem/checkpoint`, `sph/checkpoint` (node's reply to the broker's query) and `fem/restore`,
+/// `sph/restore` (broker's reply to the node's query): a node's whole state between two coupling steps, in the
+/// node's own format (opaque to the protocol; `docs/PROTOCOL.md` §9). The envelope's step and t are those of
+/// the last step the node completed. In a restore reply, `data` empty means "start from the scene".
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeCheckpoint {
+    /// `fem-node` or `sph-node`: a state is never given to the other kind of node.
+    pub node: String,
+    /// The node's state, in its own format.
+    pub data: Vec<u8>,
+}

@@ -11,7 +11,9 @@
 
 use std::fmt::Debug;
 
-use cosim_proto::messages::{Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand};
+use cosim_proto::messages::{
+    Correction, Energies, FemMesh, FemSnapshot, FemState, NodeCheckpoint, NodeError, Segment, StepCommand,
+};
 use cosim_proto::{Envelope, PROTOCOL_VERSION};
 use serde::{de::DeserializeOwned, Serialize};
 
@@ -313,6 +315,32 @@ fn fem_state_with_snapshot_golden() {
         00 00 00 00 00 00 e0 3f         #     kinetic = 0.5
         00 00 00 00 00 00 d0 3f         #     strain = 0.25
         00 00 00 00 00 00 c0 bf         #     potential = -0.125
+        ",
+    );
+}
+
+#[test]
+fn node_checkpoint_golden() {
+    let env = Envelope::new(
+        "r1",
+        7,
+        0.5,
+        NodeCheckpoint {
+            node: "fem-node".to_string(),
+            data: vec![0xde, 0xad, 0xbe],
+        },
+    );
+    check_golden(
+        &env,
+        "
+        01 00 00 00                     # protocol_version = 1
+        02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
+        07 00 00 00 00 00 00 00         # step = 7
+        00 00 00 00 00 00 e0 3f         # t = 0.5
+        08 00 00 00 00 00 00 00         # node: length 8
+        66 65 6d 2d 6e 6f 64 65         #   \"fem-node\"
+        03 00 00 00 00 00 00 00         # data: length 3
+        de ad be                        #   the node's bytes
         ",
     );
 }

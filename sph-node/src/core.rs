@@ -8,6 +8,7 @@ use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCom
 use cosim_proto::scene::Scene;
 
 use cosim_proto::scene::{FluidSolver, PpeSourceKind};
+use serde::{Deserialize, Serialize};
 
 use crate::error::SphError;
 use crate::isph::{IsphSolver, PpeSource};
@@ -15,7 +16,11 @@ use crate::particles::{FluidState, WallParticles};
 use crate::solver::{SphParams, WcsphSolver};
 use crate::stability::EnergyGuard;
 
+/// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9).
+const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 1);
+
 /// The fluid solver the scene asks for.
+#[derive(Serialize, Deserialize)]
 pub enum Fluid {
     /// Weakly compressible.
     Wcsph(WcsphSolver),
@@ -123,6 +128,43 @@ impl SphCore {
     /// The solver (tests, checkpoints).
     pub fn solver(&self) -> &Fluid {
         &self.solver
+    }
+
+    /// The node's state between two steps, for a checkpoint: the whole solver — particles, and also their order
+    /// in memory, the neighbour lists and every cache a step reads before it rebuilds them, so that a restarted
+    /// run computes the same bits — and the energy guard's bound.
+    pub fn checkpoint(&self) -> Vec<u8> {
+        let tag = CHECKPOINT_TAG;
+        bincode::serialize(&(tag.0, tag.1, &self.solver, &self.guard))
+            .expect("in-memory bincode encoding of plain data")
+    }
+
+    /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene.
+    pub fn restore(&mut self, data: &[u8]) -> Result<(), SphError> {
+        let invalid = |message: String| SphError::InvalidParameter {
+            name: "checkpoint",
+            message,
+        };
+        let (tag, version, solver, guard): (String, u32, Fluid, EnergyGuard) =
+            bincode::deserialize(data).map_err(|e| invalid(format!("not a fluid node's state: {e}")))?;
+        if (tag.as_str(), version) != CHECKPOINT_TAG {
+            return Err(invalid(format!(
+                "holds `{tag}` version {version}, this sph-node reads `{}` version {}",
+                CHECKPOINT_TAG.0, CHECKPOINT_TAG.1
+            )));
+        }
+        let (saved, scene) = (solver.state().len(), self.solver.state().len());
+        if saved != scene || solver.walls().len() != self.solver.walls().len() {
+            return Err(invalid(format!(
+                "holds {saved} fluid particles, the scene makes {scene} (another scene?)"
+            )));
+        }
+        if std::mem::discriminant(&solver) != std::mem::discriminant(&self.solver) {
+            return Err(invalid("saved with the other fluid.solver".into()));
+        }
+        self.solver = solver;
+        self.guard = guard;
+        Ok(())
     }
 
     /// Add the broker's position and velocity increments to the particles they name.

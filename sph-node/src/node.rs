@@ -34,4 +34,12 @@ impl NodeCore for SphCore {
             ("wall_particles", s.walls.len() as u64),
         ]
     }
+
+    fn checkpoint(&self) -> Option<Vec<u8>> {
+        Some(SphCore::checkpoint(self))
+    }
+
+    fn restore(&mut self, data: &[u8]) -> Result<(), Failure> {
+        SphCore::restore(self, data).map_err(Failure::from)
+    }
 }

@@ -14,6 +14,7 @@
 
 use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::boundary::{adami, walls};
 use crate::corrections::{apd, density_filter, mls};
@@ -28,7 +29,7 @@ use crate::time_step;
 use crate::wcsph::{continuity, momentum, MomentumParams};
 
 /// Resolved parameters of the fluid.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SphParams {
     /// Rest density ρ0.
     pub rho0: f64,
@@ -54,7 +55,7 @@ pub struct SphParams {
 }
 
 /// WCSPH settings beyond [`SphParams`] (kept apart so that `SphParams` stays shared with other solvers).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct WcsphOptions {
     /// The density filter passes (every [`SphParams::shepard_interval`] steps) use the first-order MLS filter
     /// (Colagrossi & Landrini 2003) instead of Shepard's.
@@ -67,7 +68,7 @@ pub struct WcsphOptions {
 
 /// The particles as the gathers see them: the fluid sorted by cell (slot k holds particle `ids[k]`), then the
 /// walls in their own order (they never move). The solver's working copy; [`FluidState`] keeps the id order.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Sorted {
     x: Vec<[f64; 2]>,
     /// Velocities (zero for walls).
@@ -88,7 +89,7 @@ struct Sorted {
 }
 
 /// Scratch rebuilt every step: nothing here is state.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Scratch {
     /// Boxed to keep the solver about as large as the ISPH one (`core::Fluid` holds either).
     cells: Box<SortedCells>,
@@ -111,7 +112,7 @@ struct Scratch {
 ///
 /// Internally the fluid particles are kept sorted by cell (see the module documentation); [`WcsphSolver::state`]
 /// is in id order, written back after every step.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WcsphSolver {
     params: SphParams,
     options: WcsphOptions,

@@ -5,9 +5,10 @@
 
 use crate::error::SphError;
 use crate::particles::{FluidState, WallParticles};
+use serde::{Deserialize, Serialize};
 
 /// Stops a run whose kinetic energy grows without bound.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EnergyGuard {
     /// Largest kinetic energy allowed [J per unit thickness]; infinite when the scene has no energy source.
     pub bound: f64,

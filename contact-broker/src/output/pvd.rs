@@ -24,6 +24,19 @@ impl PvdCollection {
         }
     }
 
+    /// A collection that starts with `entries` (a run continuing from a checkpoint keeps the frames before it);
+    /// written at once when there are any, so the file lists them even before the next frame.
+    pub fn with_entries(path: impl Into<PathBuf>, entries: Vec<(f64, String)>) -> Result<Self> {
+        let c = Self {
+            path: path.into(),
+            entries,
+        };
+        if !c.entries.is_empty() {
+            write_atomic(&c.path, c.render().as_bytes())?;
+        }
+        Ok(c)
+    }
+
     /// Path of the `.pvd` file.
     pub fn path(&self) -> &Path {
         &self.path

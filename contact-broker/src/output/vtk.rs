@@ -52,6 +52,26 @@ impl FrameWriter {
         })
     }
 
+    /// Continue the frames of a run restarted from a checkpoint: frame `k` was taken at `times[k]`, and those of
+    /// them already in `out_dir/frames/` (a restart into the same folder) stay listed in the collections.
+    pub fn resume(out_dir: &Path, times: &[f64]) -> Result<Self> {
+        let dir = out_dir.join("frames");
+        std::fs::create_dir_all(&dir).map_err(|e| OutputError::io(&dir, e))?;
+        let kept = |prefix: &str| -> Vec<(f64, String)> {
+            times
+                .iter()
+                .enumerate()
+                .map(|(k, &t)| (t, format!("{prefix}_{k:05}.vtu")))
+                .filter(|(_, name)| dir.join(name).is_file())
+                .collect()
+        };
+        Ok(Self {
+            structure: PvdCollection::with_entries(dir.join("structure.pvd"), kept("structure"))?,
+            particles: PvdCollection::with_entries(dir.join("particles.pvd"), kept("particles"))?,
+            dir,
+        })
+    }
+
     /// The frames folder, `DIR/frames`.
     pub fn dir(&self) -> &Path {
         &self.dir

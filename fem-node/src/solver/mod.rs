@@ -85,6 +85,27 @@ impl FemSolver {
         self.parallel_min_elements = n;
     }
 
+    /// Whether the accelerations are recomputed before the next step (after corrections or new velocities); a
+    /// checkpoint keeps it with the state, so that a restarted run takes the same steps.
+    pub fn accelerations_stale(&self) -> bool {
+        self.accelerations_stale
+    }
+
+    /// Continue from a saved state (a checkpoint): the state as it was, accelerations included, and whether they
+    /// were to be recomputed. The model must be the one the state was saved from (same node count).
+    pub fn resume(&mut self, state: FemState, accelerations_stale: bool) -> Result<()> {
+        let n = self.model.node_count();
+        if state.x.len() != n || state.v.len() != n || state.a.len() != n {
+            return Err(FemError::InvalidParameter {
+                name: "state",
+                message: format!("the saved state holds {} nodes, the model {n}", state.x.len()),
+            });
+        }
+        self.state = state;
+        self.accelerations_stale = accelerations_stale;
+        Ok(())
+    }
+
     /// Sets every node's velocity (clamped nodes stay at rest); accelerations are refreshed before the next step.
     pub fn set_velocities(&mut self, v: impl Fn(usize, [f64; 2]) -> [f64; 2]) {
         for k in 0..self.state.v.len() {

@@ -1,10 +1,11 @@
 //! Tait equation of state (`DESIGN.md` §4.2): p = B [(ρ/ρ0)^7 − 1], B = ρ0 c0² / 7.
 
+use serde::{Deserialize, Serialize};
 /// Polytropic exponent γ of the Tait law for water.
 pub const GAMMA: i32 = 7;
 
 /// The Tait law for one rest density and sound speed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tait {
     /// Rest density ρ0 (kg/m³).
     pub rho0: f64,

@@ -30,6 +30,7 @@
 //!   corrections and filtered by the face's travel ([`Face::velocity`], [`face_normal_velocity`]).
 
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
@@ -43,7 +44,7 @@ pub const STEPS_KEPT: u32 = 10;
 pub const FACE_TRAVEL: f64 = 0.05;
 
 /// A structure face seen from one particle: the points x with n · x = `offset`, n the unit normal into the fluid.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Face {
     /// Unit normal into the fluid.
     pub normal: [f64; 2],
@@ -93,7 +94,7 @@ pub fn half_space(kernel: &CubicSpline, dx: f64, d: f64) -> (f64, f64) {
 }
 
 /// A fluid particle against a structure face, at the predicted positions.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContactRow {
     /// The face.
     pub face: Face,
@@ -107,7 +108,7 @@ pub struct ContactRow {
 }
 
 /// Which fluid particles the contact corrected lately, and the faces they revealed.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ContactLayer {
     /// Positions at the end of the last step.
     x_end: Vec<[f64; 2]>,

@@ -19,6 +19,7 @@
 //! normal part of the fluid's motion next to them, so the flux into the wall is imposed once, by the Neumann rows.
 //! After the solve negative pressures are clipped to 0 (fluid and walls).
 
+use serde::{Deserialize, Serialize};
 pub mod bicgstab;
 pub mod contact;
 pub mod free_surface;
@@ -31,7 +32,7 @@ pub mod wall_normal;
 pub use solver::IsphSolver;
 
 /// Right-hand side of the pressure Poisson equation (`DESIGN.md` §4.3, step 2).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum PpeSource {
     /// ∇·u*_i / Δt (Cummins & Rudman 1999): the corrected velocity is divergence-free.
     #[default]
@@ -41,7 +42,7 @@ pub enum PpeSource {
 }
 
 /// Settings of the ISPH solver that the scene does not carry.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IsphOptions {
     /// PPE source term.
     pub source: PpeSource,

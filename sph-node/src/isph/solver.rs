@@ -13,6 +13,7 @@
 
 use cosim_proto::scene::{BoxSpec, FluidSolver, Scene};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use super::contact::{self, ContactLayer, ContactRow};
 use super::wall_guard::WallBoxes;
@@ -28,7 +29,7 @@ use crate::setup;
 use crate::solver::SphParams;
 
 /// Scratch rebuilt every step: nothing here is state.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Scratch {
     x: Vec<[f64; 2]>,
     v: Vec<[f64; 2]>,
@@ -46,7 +47,7 @@ struct Scratch {
 }
 
 /// What the last PPE solve did.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PpeReport {
     /// BiCGSTAB iterations.
     pub iterations: usize,
@@ -65,7 +66,7 @@ pub struct PpeReport {
 }
 
 /// Incompressible SPH solver (projection method).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IsphSolver {
     params: SphParams,
     options: IsphOptions,

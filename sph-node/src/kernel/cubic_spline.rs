@@ -3,10 +3,11 @@
 //! W(q) = α_d (1 − 1.5 q² + 0.75 q³) for 0 ≤ q < 1, α_d · 0.25 (2 − q)³ for 1 ≤ q < 2, 0 beyond;
 //! q = r/h, α_d = 10 / (7 π h²). The support radius is 2h.
 
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// The cubic spline kernel for one smoothing length h.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CubicSpline {
     h: f64,
     alpha: f64,

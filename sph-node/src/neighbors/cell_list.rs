@@ -7,9 +7,10 @@
 //! same order whatever the thread count.
 
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 /// Particles binned on a uniform grid.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct CellList {
     origin: [f64; 2],
     cell_size: f64,
@@ -136,7 +137,7 @@ impl CellList {
 pub const CHUNK: usize = 256;
 
 /// The neighbour lists of [`CHUNK`] consecutive particles, stored together, with optional kernel factors per pair.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ListChunk {
     /// First particle of the chunk.
     first: usize,
@@ -252,7 +253,7 @@ impl ListChunk {
 
 /// Per-particle neighbour lists (self excluded), each in the fixed gather order, stored in chunks of [`CHUNK`]
 /// particles that are built in parallel and never concatenated.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct NeighborList {
     n: usize,
     chunks: Vec<ListChunk>,

@@ -1,0 +1,285 @@
+//! Checkpoints of a run (`cosim run --checkpoint-interval T`) and restarts from them (`cosim run SCENE --restart
+//! DIR/checkpoints/<step>`).
+//!
+//! A checkpoint is taken between two coupling steps, when every node has answered step `step` and the contact
+//! corrections of that step are computed but not yet sent. It is a folder `DIR/checkpoints/<step>/`:
+//!
+//! - `checkpoint.json`: the manifest ([`Manifest`]): format and protocol version, run id, step, t, file sizes;
+//! - `scene.toml`: the resolved scene the run was started with;
+//! - `broker.bin`: the coordinator's state ([`BrokerState`]): time, step, the pending corrections, the probe rows
+//!   so far, the summary's counters;
+//! - `fem.bin`, `sph.bin`: each node's own state, as the node saved it (opaque here, `docs/PROTOCOL.md` §9).
+//!
+//! The folder is written under a temporary name and renamed when complete, so a run that dies while it writes
+//! never leaves a half checkpoint that looks whole. Pure: files only, no messaging.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use cosim_proto::envelope::PROTOCOL_VERSION;
+use cosim_proto::messages::Correction;
+use cosim_proto::scene::LoadedScene;
+use serde::{Deserialize, Serialize};
+
+use crate::summary::Summary;
+
+/// Version of the checkpoint folder's layout and of `broker.bin`.
+pub const FORMAT: u32 = 1;
+/// The manifest's file name.
+pub const MANIFEST: &str = "checkpoint.json";
+const TAG: &str = "cosim-broker-checkpoint";
+
+/// `checkpoint.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`FORMAT`] of the writer.
+    pub format: u32,
+    /// Wire protocol version of the writer (`cosim_proto::envelope::PROTOCOL_VERSION`).
+    pub protocol_version: u32,
+    /// Run that wrote it.
+    pub run_id: String,
+    /// Scene name (`run.name`).
+    pub scene: String,
+    /// Coupling steps completed.
+    pub step: u64,
+    /// Simulated time reached [s].
+    pub t: f64,
+    /// Size of each file [bytes].
+    pub files: BTreeMap<String, u64>,
+    /// Seconds it took to gather the nodes' states and write the folder.
+    pub write_seconds: f64,
+}
+
+/// The coordinator's state between two steps: what, with the nodes' states, makes the continued run the same.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BrokerState {
+    /// Coupling steps completed.
+    pub step: u64,
+    /// Simulated time [s].
+    pub t: f64,
+    /// Index of the next output time.
+    pub next_output: u64,
+    /// Index of the next checkpoint time.
+    pub next_checkpoint: u64,
+    /// The fluid's stable step last reported [s].
+    pub dt_fluid: f64,
+    /// Contact corrections of the last step, still to be sent to the structure node.
+    pub pending_fem: Vec<Correction>,
+    /// … and to the fluid node.
+    pub pending_sph: Vec<Correction>,
+    /// Region of interest of the next fluid command.
+    pub roi: Option<[f64; 4]>,
+    /// Interface load of the last output step.
+    pub load: Option<Vec<[f64; 2]>>,
+    /// Fluid particles exchanged over the run.
+    pub exchanged: u64,
+    /// Fluid positions of the first sample (potential energy probes).
+    pub fluid_origin: Option<Vec<[f64; 2]>>,
+    /// Every probe row so far: time and values.
+    pub rows: Vec<(f64, Vec<f64>)>,
+    /// The summary's counters so far.
+    pub summary: Summary,
+}
+
+/// A checkpoint read back and checked against the scene of the run that continues from it.
+#[derive(Debug)]
+pub struct Restart {
+    /// The folder.
+    pub dir: PathBuf,
+    /// Its manifest.
+    pub manifest: Manifest,
+    /// The coordinator's state.
+    pub broker: BrokerState,
+    /// The structure node's state, when the scene has one.
+    pub fem: Option<Vec<u8>>,
+    /// The fluid node's state, when the scene has one.
+    pub sph: Option<Vec<u8>>,
+}
+
+/// What [`write`] did.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// The checkpoint folder.
+    pub dir: PathBuf,
+    /// Bytes written.
+    pub bytes: u64,
+    /// Seconds it took to write (the nodes' states included, when `started` was taken before gathering them).
+    pub seconds: f64,
+}
+
+/// Write `out/checkpoints/<step>/`. `nodes` are `("fem", bytes)` and/or `("sph", bytes)`; `started` is when the
+/// checkpoint began (before the nodes were asked), for the manifest's `write_seconds`.
+pub fn write(
+    out: &Path,
+    run_id: &str,
+    scene: &LoadedScene,
+    state: &BrokerState,
+    nodes: &[(&str, Vec<u8>)],
+    started: Instant,
+) -> anyhow::Result<Written> {
+    let root = out.join("checkpoints");
+    let dir = root.join(state.step.to_string());
+    let tmp = root.join(format!(".{}.partial", state.step));
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp).with_context(|| format!("cannot clear {}", tmp.display()))?;
+    }
+    std::fs::create_dir_all(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+    let mut files = BTreeMap::new();
+    let mut put = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
+        let path = tmp.join(name);
+        std::fs::write(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+        files.insert(name.to_string(), bytes.len() as u64);
+        Ok(())
+    };
+    put("scene.toml", scene.scene.to_toml().as_bytes())?;
+    let broker = bincode::serialize(&(TAG, FORMAT, state)).expect("in-memory bincode encoding of plain data");
+    put("broker.bin", &broker)?;
+    for (node, bytes) in nodes {
+        put(&format!("{node}.bin"), bytes)?;
+    }
+    let mut manifest = Manifest {
+        format: FORMAT,
+        protocol_version: PROTOCOL_VERSION,
+        run_id: run_id.to_string(),
+        scene: scene.scene.run.name.clone(),
+        step: state.step,
+        t: state.t,
+        files,
+        write_seconds: 0.0,
+    };
+    manifest.write_seconds = started.elapsed().as_secs_f64();
+    let text = serde_json::to_string_pretty(&manifest)? + "\n";
+    let path = tmp.join(MANIFEST);
+    std::fs::write(&path, &text).with_context(|| format!("cannot write {}", path.display()))?;
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).with_context(|| format!("cannot replace {}", dir.display()))?;
+    }
+    std::fs::rename(&tmp, &dir).with_context(|| format!("cannot rename {} to {}", tmp.display(), dir.display()))?;
+    Ok(Written {
+        bytes: manifest.files.values().sum::<u64>() + text.len() as u64,
+        dir,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Read the checkpoint `dir` and check that `scene` may continue from it: same format and protocol version, and
+/// the same scene but for `run.end_time` (a restart may run longer or shorter). Every refusal names the file.
+pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
+    let manifest_path = dir.join(MANIFEST);
+    let text = std::fs::read_to_string(&manifest_path).with_context(|| {
+        format!(
+            "{}: not a checkpoint (give a folder DIR/checkpoints/<step> that a run with --checkpoint-interval wrote)",
+            manifest_path.display()
+        )
+    })?;
+    let manifest: Manifest = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a checkpoint manifest", manifest_path.display()))?;
+    anyhow::ensure!(
+        manifest.protocol_version == PROTOCOL_VERSION,
+        "{}: written by protocol version {}, this build speaks {PROTOCOL_VERSION}; restart with the build that wrote it",
+        manifest_path.display(),
+        manifest.protocol_version
+    );
+    anyhow::ensure!(
+        manifest.format == FORMAT,
+        "{}: checkpoint format {}, this build reads format {FORMAT}",
+        manifest_path.display(),
+        manifest.format
+    );
+    let scene_path = dir.join("scene.toml");
+    let saved_text =
+        std::fs::read_to_string(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;
+    let mut saved = cosim_proto::scene::parse(&scene_path.display().to_string(), &saved_text, &[])?;
+    saved.run.end_time = scene.scene.run.end_time;
+    if let Some((ours, theirs)) = first_difference(&scene.scene.to_toml(), &saved.to_toml()) {
+        anyhow::bail!(
+            "{}: the checkpoint is from another scene: {} has `{ours}` where the checkpoint has `{theirs}` \
+             (only run.end_time may differ)",
+            scene_path.display(),
+            scene.path.display()
+        );
+    }
+    let read = |name: &str| -> anyhow::Result<Vec<u8>> {
+        let path = dir.join(name);
+        std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))
+    };
+    let broker_path = dir.join("broker.bin");
+    let (tag, format, broker): (String, u32, BrokerState) = bincode::deserialize(&read("broker.bin")?)
+        .with_context(|| format!("{}: not a broker state", broker_path.display()))?;
+    anyhow::ensure!(
+        tag == TAG && format == FORMAT,
+        "{}: holds `{tag}` format {format}, this build reads `{TAG}` format {FORMAT}",
+        broker_path.display()
+    );
+    anyhow::ensure!(
+        broker.step == manifest.step && broker.t.to_bits() == manifest.t.to_bits(),
+        "{}: step {} at t = {} does not match {} (step {}, t = {})",
+        broker_path.display(),
+        broker.step,
+        broker.t,
+        manifest_path.display(),
+        manifest.step,
+        manifest.t
+    );
+    let fem = match scene.scene.solids.is_empty() {
+        false => Some(read("fem.bin")?),
+        true => None,
+    };
+    let sph = match scene.scene.fluid {
+        Some(_) => Some(read("sph.bin")?),
+        None => None,
+    };
+    Ok(Restart {
+        dir: dir.to_path_buf(),
+        manifest,
+        broker,
+        fem,
+        sph,
+    })
+}
+
+/// The first line that differs between two texts, `(ours, theirs)`; `None` when they are equal.
+fn first_difference(ours: &str, theirs: &str) -> Option<(String, String)> {
+    let (mut a, mut b) = (ours.lines(), theirs.lines());
+    // The section a line is in, so that `spacing = …` reads as `[fluid] spacing = …`.
+    let mut section = String::new();
+    loop {
+        match (a.next(), b.next()) {
+            (None, None) => return None,
+            (x, y) if x == y => {
+                let line = x.unwrap_or_default().trim();
+                if line.starts_with('[') {
+                    section = format!("{line} ");
+                }
+            }
+            (x, y) => {
+                let show = |l: Option<&str>| match l.map(str::trim) {
+                    None => "(end of scene)".to_string(),
+                    Some(l) if l.starts_with('[') => l.to_string(),
+                    Some(l) => format!("{section}{l}"),
+                };
+                return Some((show(x), show(y)));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_difference;
+
+    #[test]
+    fn first_difference_names_the_line() {
+        assert_eq!(first_difference("a = 1\nb = 2\n", "a = 1\nb = 2\n"), None);
+        assert_eq!(
+            first_difference("[run]\na = 1\nb = 2\n", "[run]\na = 1\nb = 3\n"),
+            Some(("[run] b = 2".into(), "[run] b = 3".into()))
+        );
+        assert_eq!(
+            first_difference("a = 1\n", "a = 1\nc = 0\n"),
+            Some(("(end of scene)".into(), "c = 0".into()))
+        );
+    }
+}

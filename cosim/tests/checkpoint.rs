@@ -1,0 +1,316 @@
+//! Checkpoint and restart (`cosim run --checkpoint-interval T`, `cosim run SCENE --restart DIR/checkpoints/<step>`):
+//! a coupled run as three processes that loses a node mid-run continues from its last checkpoint, into the same
+//! folder, and ends with outputs byte-identical to the run that was never interrupted — probes.csv, every frame
+//! and the ParaView collections. The same checkpoint continued in one process gives the same probes (processes and
+//! in-process compute the same bits), and so does an ISPH run, whose solver carries more state between steps. A
+//! checkpoint from another scene or another protocol version is refused up front, naming the file and the key.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::*;
+
+/// Bound on every wait; no test may hang.
+const LIMIT: Duration = Duration::from_secs(240);
+/// A shipped scene, by absolute path (the tests run in the crate's folder).
+fn scene(name: &str) -> String {
+    root().join("scenes").join(name).display().to_string()
+}
+/// The coarse gate (875 particles) for 0.2 s with a checkpoint every 0.05 s.
+const GATE: [&str; 6] = [
+    "--set",
+    "fluid.spacing=0.004",
+    "--set",
+    "run.end_time=0.2",
+    "--checkpoint-interval",
+    "0.05",
+];
+
+fn run_ok(args: &[&str]) {
+    let out = cosim_run(args, LIMIT);
+    assert!(
+        out.status.success(),
+        "cosim {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The checkpoint folders of a run, by step.
+fn checkpoints(out: &Path) -> Vec<(u64, PathBuf)> {
+    let mut found: Vec<(u64, PathBuf)> = std::fs::read_dir(out.join("checkpoints"))
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| Some((e.file_name().to_str()?.parse().ok()?, e.path())))
+        .collect();
+    found.sort();
+    found
+}
+
+/// Every file of a folder tree (relative path, bytes), checkpoints and logs left out.
+fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let path = e.path();
+            let rel = path.strip_prefix(dir).unwrap().display().to_string();
+            if ["checkpoints", "logs", "summary.json"].iter().any(|s| rel == *s) {
+                continue;
+            }
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                files.push((rel, std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
+    let dir = scratch("checkpoint");
+    let (reference, crashed, in_process) = (dir.join("reference"), dir.join("crashed"), dir.join("in_process"));
+    let s = |p: &Path| p.display().to_string();
+
+    // The run nobody interrupts.
+    let gate = scene("elastic_gate.toml");
+    let mut args = vec!["run", &gate, "--quiet"];
+    args.extend(GATE);
+    let reference_s = s(&reference);
+    run_ok(&[&args[..], &["--out", &reference_s, "--run-id", &run_id("ck-ref")]].concat());
+    let written = checkpoints(&reference);
+    assert_eq!(written.len(), 4, "checkpoints at 0.05, 0.1, 0.15, 0.2 s: {written:?}");
+    let manifest = json(&written[0].1.join("checkpoint.json"));
+    assert_eq!(manifest["t"].as_f64(), Some(0.05));
+    assert_eq!(manifest["protocol_version"].as_u64(), Some(1));
+    for file in ["scene.toml", "broker.bin", "fem.bin", "sph.bin"] {
+        assert!(manifest["files"][file].as_u64().unwrap() > 0, "{file} in {manifest}");
+    }
+
+    // The same run, its fluid node killed once the first checkpoint is on disk.
+    let mut cmd = Command::new(cosim());
+    cmd.current_dir(root())
+        .env("COSIM_BIN_DIR", bin_dir())
+        .args(&args)
+        .arg("--out")
+        .arg(&crashed)
+        .args(["--run-id", &run_id("ck-crash")])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    let mut run = Kill(cmd.spawn().unwrap());
+    let started = Instant::now();
+    while checkpoints(&crashed).is_empty() {
+        assert!(
+            run.0.try_wait().unwrap().is_none(),
+            "the run ended before its first checkpoint"
+        );
+        assert!(started.elapsed() < LIMIT, "no checkpoint within {LIMIT:?}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = Command::new("pkill")
+        .args(["-KILL", "-P", &run.0.id().to_string(), "sph-node"])
+        .status()
+        .unwrap();
+    assert!(killed.success(), "pkill sph-node");
+    let status = wait_exit(
+        &mut run.0,
+        Instant::now() + LIMIT,
+        "cosim after its sph-node was killed",
+    );
+    assert_eq!(status.code(), Some(1), "the killed run fails");
+    let last = checkpoints(&crashed).pop().unwrap();
+    assert!(last.0 < written[3].0, "killed before the end: {last:?}");
+
+    // Continued into its own folder: everything it writes equals the uninterrupted run's.
+    let (crashed_s, last_s) = (s(&crashed), s(&last.1));
+    run_ok(
+        &[
+            &args[..],
+            &[
+                "--out",
+                &crashed_s,
+                "--restart",
+                &last_s,
+                "--run-id",
+                &run_id("ck-restart"),
+            ],
+        ]
+        .concat(),
+    );
+    let (want, got) = (tree(&reference), tree(&crashed));
+    assert_eq!(
+        want.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        got.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        "the same files"
+    );
+    for ((name, a), (_, b)) in want.iter().zip(&got) {
+        assert!(a == b, "{name} differs after the restart");
+    }
+    let summary = json(&crashed.join("summary.json"));
+    assert_eq!(summary["status"], "ok");
+    assert_eq!(summary["steps"].as_u64(), Some(written[3].0));
+    assert_eq!(
+        checkpoints(&crashed).len(),
+        4,
+        "the restarted run goes on writing checkpoints"
+    );
+
+    // The same checkpoint continued in one process.
+    let in_process_s = s(&in_process);
+    let restart = [
+        "run",
+        &gate,
+        "--quiet",
+        "--in-process",
+        "--set",
+        "fluid.spacing=0.004",
+        "--set",
+        "run.end_time=0.2",
+    ];
+    run_ok(&[&restart[..], &["--out", &in_process_s, "--restart", &last_s]].concat());
+    let probes = |d: &Path| std::fs::read(d.join("probes.csv")).unwrap();
+    assert!(
+        probes(&in_process) == probes(&reference),
+        "in-process restart: probes.csv differs"
+    );
+}
+
+#[test]
+fn isph_restart_is_byte_identical() {
+    let dir = scratch("checkpoint-isph");
+    let (whole, continued) = (dir.join("whole"), dir.join("continued"));
+    let gate = scene("elastic_gate.toml");
+    let base = [
+        "run",
+        &gate,
+        "--quiet",
+        "--in-process",
+        "--set",
+        "fluid.solver=isph",
+        "--set",
+        "fluid.spacing=0.006",
+        "--set",
+        "run.end_time=0.1",
+    ];
+    let whole_s = whole.display().to_string();
+    run_ok(&[&base[..], &["--out", &whole_s, "--checkpoint-interval", "0.05"]].concat());
+    let first = checkpoints(&whole).remove(0).1.display().to_string();
+    let continued_s = continued.display().to_string();
+    run_ok(&[&base[..], &["--out", &continued_s, "--restart", &first]].concat());
+    let probes = |d: &Path| std::fs::read(d.join("probes.csv")).unwrap();
+    assert!(probes(&whole).len() > 200, "samples written");
+    assert!(probes(&whole) == probes(&continued), "ISPH restart: probes.csv differs");
+}
+
+#[test]
+fn a_checkpoint_from_another_scene_or_version_is_refused() {
+    let dir = scratch("checkpoint-refused");
+    let out = dir.join("run");
+    let out_s = out.display().to_string();
+    let (gate, dam) = (scene("elastic_gate.toml"), scene("dam_break.toml"));
+    run_ok(&[
+        "run",
+        &gate,
+        "--quiet",
+        "--in-process",
+        "--out",
+        &out_s,
+        "--set",
+        "fluid.spacing=0.006",
+        "--set",
+        "run.end_time=0.02",
+        "--checkpoint-interval",
+        "0.01",
+    ]);
+    let (_, ck) = checkpoints(&out).remove(0);
+    let ck_s = ck.display().to_string();
+    let refused = |args: &[&str], expect: &[&str]| {
+        let got = cosim_run(args, LIMIT);
+        let stderr = String::from_utf8_lossy(&got.stderr);
+        assert_eq!(got.status.code(), Some(2), "bad input: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "one line: {stderr}");
+        for e in expect {
+            assert!(stderr.contains(e), "`{e}` in: {stderr}");
+        }
+    };
+    let again = dir.join("again").display().to_string();
+    // Another spacing: the line that differs is named.
+    refused(
+        &[
+            "run",
+            &gate,
+            "--out",
+            &again,
+            "--set",
+            "fluid.spacing=0.005",
+            "--restart",
+            &ck_s,
+        ],
+        &[
+            "scene.toml",
+            "another scene",
+            "[fluid] spacing = 0.005",
+            "[fluid] spacing = 0.006",
+        ],
+    );
+    // Another scene altogether.
+    refused(
+        &["run", &dam, "--out", &again, "--restart", &ck_s],
+        &["another scene", "name = \"dam_break\""],
+    );
+    // Another protocol version.
+    let other = dir.join("other_version");
+    std::fs::create_dir_all(&other).unwrap();
+    for e in std::fs::read_dir(&ck).unwrap().flatten() {
+        std::fs::copy(e.path(), other.join(e.file_name())).unwrap();
+    }
+    let manifest = other.join("checkpoint.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(
+        &manifest,
+        text.replace("\"protocol_version\": 1", "\"protocol_version\": 7"),
+    )
+    .unwrap();
+    let other_s = other.display().to_string();
+    refused(
+        &[
+            "run",
+            &gate,
+            "--out",
+            &again,
+            "--set",
+            "fluid.spacing=0.006",
+            "--restart",
+            &other_s,
+        ],
+        &["checkpoint.json", "protocol version 7"],
+    );
+    // Not a checkpoint folder.
+    refused(
+        &["run", &gate, "--out", &again, "--restart", &out_s],
+        &["checkpoint.json", "not a checkpoint"],
+    );
+    // An outside program cannot save its state.
+    refused(
+        &[
+            "run",
+            &gate,
+            "--out",
+            &again,
+            "--external",
+            "fem",
+            "--checkpoint-interval",
+            "0.1",
+        ],
+        &["--external fem", "checkpoint"],
+    );
+    assert!(!dir.join("again").join("probes.csv").exists(), "nothing ran");
+}
