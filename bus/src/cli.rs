@@ -1,4 +1,7 @@
-//! The command line every solver node binary shares: `--run ID --connect ENDPOINT [--client] [--threads N]`.
+//! The command line every solver node binary shares:
+//! `--run ID --connect ENDPOINT [--client] [--zenoh-config FILE] [--threads N]`.
+
+use std::path::PathBuf;
 
 use clap::Parser;
 use cosim_proto::keys::NodeTopics;
@@ -28,6 +31,10 @@ struct Args {
     /// `--connect` is a zenoh router (`zenohd`): join through it as a client, as every process of the run must.
     #[arg(long, conflicts_with = "listen")]
     client: bool,
+    /// A zenoh JSON5 config file the session starts from (user and password, TLS certificates, …); the node's own
+    /// settings (mode, endpoints, multicast scouting off, timeouts) are put on top of it.
+    #[arg(long, value_name = "FILE")]
+    zenoh_config: Option<PathBuf>,
 }
 
 /// The whole `main` of a node binary: parse the arguments, serve, and exit non-zero with one line on stderr.
@@ -52,6 +59,7 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
         listen: args.listen,
         timeout_ms: (args.timeout * 1000.0) as u64,
         client: args.client,
+        zenoh_config: args.zenoh_config,
     };
     match serve(&opts, topics, build) {
         Ok(()) => std::process::exit(0),

@@ -29,6 +29,8 @@ pub struct NodeOptions {
     pub timeout_ms: u64,
     /// Join as a zenoh client through the router at `connect` (a run spread over hosts) instead of as a peer.
     pub client: bool,
+    /// A zenoh config file the session starts from (`crate::session::base_config`).
+    pub zenoh_config: Option<std::path::PathBuf>,
 }
 
 /// A node's failure: a numerical blow-up (`unstable`) or anything else.
@@ -92,9 +94,10 @@ pub fn serve<C: NodeCore>(
     topics: NodeTopics,
     build: impl FnOnce(&Scene) -> Result<C, Failure>,
 ) -> anyhow::Result<()> {
+    let base = opts.zenoh_config.as_deref();
     let session = match opts.client {
-        true => crate::session::open_client(&opts.connect, opts.timeout_ms),
-        false => crate::session::open_session(&opts.listen, &opts.connect, opts.timeout_ms),
+        true => crate::session::open_client_from(base, &opts.connect, opts.timeout_ms),
+        false => crate::session::open_session_from(base, &opts.listen, &opts.connect, opts.timeout_ms),
     }
     .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
     let run = opts.run.as_str();

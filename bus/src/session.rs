@@ -1,64 +1,171 @@
 //! Opening zenoh sessions with the project's settings (loopback peers, multicast scouting off).
+//!
+//! Every session starts from a base config: zenoh's defaults, or a zenoh JSON5 config file (`--zenoh-config FILE`
+//! on every binary). The project's own settings (`cosim_proto::session`: mode, multicast scouting off, endpoints,
+//! timeouts) are inserted on top of it, so the file contributes everything else: `transport/auth/usrpwd` (user and
+//! password, or a router's dictionary file), `transport/link/tls` (certificates and keys), and so on.
+
+use std::path::Path;
 
 use anyhow::Context;
 use zenoh::{Session, Wait};
 
-/// Open a peer session: listen on `listen`, connect to `connect`; a connect endpoint that does not answer
-/// within `timeout_ms` is an error, not an endless retry.
-pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
-    let mut config = zenoh::Config::default();
-    for (k, v) in cosim_proto::session::peer_settings(listen, connect, timeout_ms) {
+/// The base config: zenoh's defaults without a file, else the file (JSON5, `.json5` or `.json`; YAML `.yaml`)
+/// read with `zenoh::Config::from_file`. A file that cannot be read or parsed is one error naming it.
+pub fn base_config(file: Option<&Path>) -> anyhow::Result<zenoh::Config> {
+    let Some(file) = file else {
+        return Ok(zenoh::Config::default());
+    };
+    // zenoh's own message for a missing file does not name it; ours does, with the reason.
+    std::fs::metadata(file).with_context(|| format!("zenoh config {}: cannot read it", file.display()))?;
+    zenoh::Config::from_file(file).map_err(|e| anyhow::anyhow!("zenoh config {}: {}", file.display(), one_line(&e)))
+}
+
+/// A zenoh error on one line, without the source location zenoh appends (` at …/lib.rs:1483.`).
+fn one_line(e: &dyn std::fmt::Display) -> String {
+    let text = e.to_string();
+    let text = match text.rfind(" at ") {
+        Some(i) if text.trim_end().ends_with('.') && text[i..].contains(".rs:") => &text[..i],
+        _ => text.as_str(),
+    };
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// `base` with `settings` inserted on top.
+fn with_settings(base: Option<&Path>, settings: Vec<(String, String)>) -> anyhow::Result<zenoh::Config> {
+    let mut config = base_config(base)?;
+    for (k, v) in settings {
         config
             .insert_json5(&k, &v)
             .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
     }
-    zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
+    Ok(config)
+}
+
+fn open(config: zenoh::Config) -> anyhow::Result<Session> {
+    zenoh::open(config)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("{}", one_line(&e)))
+}
+
+/// Open a peer session: listen on `listen`, connect to `connect`; a connect endpoint that does not answer
+/// within `timeout_ms` is an error, not an endless retry.
+pub fn open_session(listen: &[String], connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
+    open_session_from(None, listen, connect, timeout_ms)
+}
+
+/// [`open_session`] on top of the config file `base` (see [`base_config`]).
+pub fn open_session_from(
+    base: Option<&Path>,
+    listen: &[String],
+    connect: &[String],
+    timeout_ms: u64,
+) -> anyhow::Result<Session> {
+    open(with_settings(
+        base,
+        cosim_proto::session::peer_settings(listen, connect, timeout_ms),
+    )?)
 }
 
 /// Open a client session through the router(s) at `connect` (`cosim_proto::session::client_settings`): how every
 /// process of a run joins when the run goes through a router instead of peer to peer.
 pub fn open_client(connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
+    open_client_from(None, connect, timeout_ms)
+}
+
+/// [`open_client`] on top of the config file `base` (see [`base_config`]).
+pub fn open_client_from(base: Option<&Path>, connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
     anyhow::ensure!(
         !connect.is_empty(),
         "client mode needs a router to connect to (--connect)"
     );
-    let mut config = zenoh::Config::default();
-    for (k, v) in cosim_proto::session::client_settings(connect, timeout_ms) {
-        config
-            .insert_json5(&k, &v)
-            .map_err(|e| anyhow::anyhow!("zenoh setting {k} = {v}: {e}"))?;
+    let session = open(with_settings(
+        base,
+        cosim_proto::session::client_settings(connect, timeout_ms),
+    )?);
+    // A router that refuses a user, a password or a certificate only closes the link: say where to look.
+    match (session, base) {
+        (Err(e), Some(file)) => Err(e.context(format!(
+            "the router did not let this process in (check the address, and the user, password or TLS settings \
+             of {})",
+            file.display()
+        ))),
+        (session, _) => session,
     }
-    zenoh::open(config).wait().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// Open a session that listens. A TCP listen endpoint with port 0 gets a free port picked here (zenoh's own
-/// listing of bound locators is an unstable API), retried a few times in case another program takes it first.
-/// Returns the session and the endpoints it listens on.
+/// Open a session that listens. A TCP (or TLS) listen endpoint with port 0 gets a free port picked here (zenoh's
+/// own listing of bound locators is an unstable API), retried a few times in case another program takes it
+/// first. Returns the session and the endpoints it listens on.
 pub fn open_listening(
     listen: &[String],
     connect: &[String],
     timeout_ms: u64,
 ) -> anyhow::Result<(Session, Vec<String>)> {
+    open_listening_from(None, listen, connect, timeout_ms)
+}
+
+/// [`open_listening`] on top of the config file `base` (see [`base_config`]).
+pub fn open_listening_from(
+    base: Option<&Path>,
+    listen: &[String],
+    connect: &[String],
+    timeout_ms: u64,
+) -> anyhow::Result<(Session, Vec<String>)> {
+    // A bad file is reported once, not hidden behind the retries.
+    base_config(base)?;
+    retry_ports(listen, |endpoints| {
+        open_session_from(base, endpoints, connect, timeout_ms)
+    })
+}
+
+/// Open a zenoh router (`cosim_proto::session::router_settings`) listening on `listen`, on top of the config
+/// file `base`: the hub of a run spread over hosts, where every process joins as a client. It is the router
+/// `zenohd` runs. Returns the session and the endpoints it listens on (port 0 replaced as in [`open_listening`]).
+pub fn open_router(base: Option<&Path>, listen: &[String], timeout_ms: u64) -> anyhow::Result<(Session, Vec<String>)> {
+    anyhow::ensure!(!listen.is_empty(), "a router needs an endpoint to listen on (--listen)");
+    base_config(base)?;
+    retry_ports(listen, |endpoints| {
+        open(with_settings(
+            base,
+            cosim_proto::session::router_settings(endpoints, timeout_ms),
+        )?)
+    })
+}
+
+/// Call `open` with `listen` made concrete ([`concrete`]), up to five times while it fails.
+fn retry_ports(
+    listen: &[String],
+    mut open: impl FnMut(&[String]) -> anyhow::Result<Session>,
+) -> anyhow::Result<(Session, Vec<String>)> {
     let mut last = None;
     for _ in 0..5 {
         let endpoints = listen.iter().map(|e| concrete(e)).collect::<anyhow::Result<Vec<_>>>()?;
-        match open_session(&endpoints, connect, timeout_ms) {
+        match open(&endpoints) {
             Ok(session) => return Ok((session, endpoints)),
             Err(e) => last = Some(e),
+        }
+        // A fixed port that failed fails the same way again.
+        if endpoints == listen {
+            break;
         }
     }
     Err(last.expect("at least one attempt"))
 }
 
-/// `tcp/HOST:0` with a free port of HOST; other endpoints unchanged.
+/// `tcp/HOST:0` (or `tls/HOST:0`) with a free port of HOST; other endpoints unchanged.
 fn concrete(endpoint: &str) -> anyhow::Result<String> {
-    match endpoint.strip_prefix("tcp/").and_then(|a| a.strip_suffix(":0")) {
+    let (scheme, rest) = match endpoint.split_once('/') {
+        Some((s @ ("tcp" | "tls"), rest)) => (s, rest),
+        _ => return Ok(endpoint.to_string()),
+    };
+    match rest.strip_suffix(":0") {
         Some(host) => {
             let port = std::net::TcpListener::bind((host, 0))
                 .and_then(|l| l.local_addr())
                 .with_context(|| format!("no free port on {host}"))?
                 .port();
-            Ok(format!("tcp/{host}:{port}"))
+            Ok(format!("{scheme}/{host}:{port}"))
         }
         None => Ok(endpoint.to_string()),
     }

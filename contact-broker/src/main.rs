@@ -52,6 +52,10 @@ struct Args {
     /// Continue from this checkpoint folder (`DIR/checkpoints/<step>`) instead of from the scene.
     #[arg(long, value_name = "DIR")]
     restart: Option<PathBuf>,
+    /// A zenoh JSON5 config file the session starts from (user and password, TLS certificates, …); the broker's
+    /// own settings (mode, endpoints, multicast scouting off, timeouts) are put on top of it.
+    #[arg(long, value_name = "FILE")]
+    zenoh_config: Option<PathBuf>,
     /// Mode written into summary.json.
     #[arg(long, default_value = "processes")]
     mode: String,
@@ -93,11 +97,14 @@ fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let base = args.zenoh_config.as_deref();
+    // A bad config file is its own error, not "cannot open a session".
+    cosim_bus::session::base_config(base)?;
     let (session, endpoints) = match args.client {
-        true => transport::open_client(&args.connect, 5000)
+        true => transport::open_client_from(base, &args.connect, 5000)
             .map(|s| (s, Vec::new()))
             .with_context(|| format!("cannot join the router {:?}", args.connect))?,
-        false => transport::open_listening(&args.listen, &args.connect, 5000).with_context(|| {
+        false => transport::open_listening_from(base, &args.listen, &args.connect, 5000).with_context(|| {
             format!(
                 "cannot open a zenoh session (listen {:?}, connect {:?})",
                 args.listen, args.connect

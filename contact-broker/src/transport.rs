@@ -16,7 +16,9 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 
-pub use cosim_bus::session::{open_client, open_listening, open_session};
+pub use cosim_bus::session::{
+    open_client, open_client_from, open_listening, open_listening_from, open_session, open_session_from,
+};
 
 /// Answer `cosim/<run>/scene` with the resolved scene (TOML text) for as long as the returned handle lives.
 pub fn serve_scene(session: &Session, run: &str, scene_toml: String) -> anyhow::Result<Queryable<()>> {

@@ -27,6 +27,9 @@ pub enum Command {
     /// Run the benchmark suite: run time, memory and error of the validation scenes at several spacings, and
     /// cost per particle-step at four sizes (writes DIR/bench.json, DIR/report.md, DIR/pareto.svg).
     Bench(BenchArgs),
+    /// Serve as a zenoh router (the one `zenohd` runs) until killed: the hub of a run spread over hosts, which every
+    /// process joins with `--connect ENDPOINT --client`.
+    Router(RouterArgs),
     /// One case of `cosim bench`: `cosim run` that also writes its peak resident memory and CPU time to a file.
     #[command(hide = true)]
     BenchRun(BenchRunArgs),
@@ -55,6 +58,11 @@ pub struct RunArgs {
     /// Worker threads per node (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// A zenoh JSON5 config file (user and password, TLS certificates, …) given to every process started, as
+    /// their `--zenoh-config`; their own settings (mode, endpoints, multicast scouting off) go on top of it.
+    /// Checked, but unused, with `--in-process`.
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
@@ -187,10 +195,25 @@ pub struct InspectArgs {
     /// `--connect` is a zenoh router: join through it as a client.
     #[arg(long)]
     pub client: bool,
+    /// A zenoh JSON5 config file the session starts from (as the run's `--zenoh-config`).
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
     /// Seconds to wait for the answers.
     #[arg(long, default_value_t = 2.0)]
     pub timeout: f64,
     /// Seconds between refreshes of the table.
     #[arg(long, default_value_t = 1.0)]
     pub interval: f64,
+}
+
+/// `cosim router`.
+#[derive(Args, Debug, Clone)]
+pub struct RouterArgs {
+    /// Endpoints to listen on (repeatable), e.g. `tcp/0.0.0.0:7447`, `tls/0.0.0.0:7447`.
+    #[arg(long, required = true)]
+    pub listen: Vec<String>,
+    /// A zenoh JSON5 config file the router starts from (a user/password dictionary, TLS certificates, …); mode,
+    /// listen endpoints and multicast scouting off are put on top of it.
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
 }

@@ -5,7 +5,7 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use cosim_bus::session::{open_client, open_listening};
+use cosim_bus::session::{base_config, open_client_from, open_listening_from};
 use cosim_bus::status::query_all;
 
 use crate::cli::InspectArgs;
@@ -75,10 +75,14 @@ fn table(doc: &serde_json::Value) -> String {
 
 /// Run `cosim inspect`; `Err` for bad input (exit 2).
 pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
-    let (connect, client) = match &args.connect {
-        Some(c) => (c.clone(), args.client),
+    let (connect, client, zenoh_config) = match &args.connect {
+        Some(c) => (c.clone(), args.client, args.zenoh_config.clone()),
         None => match registry::lookup(&args.id) {
-            Some(e) => (e.connect, e.client || args.client),
+            Some(e) => (
+                e.connect,
+                e.client || args.client,
+                args.zenoh_config.clone().or(e.zenoh_config),
+            ),
             None => anyhow::bail!(
                 "run `{}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
                  elsewhere (in-process runs have no status to inspect)",
@@ -88,12 +92,16 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         },
     };
     let timeout_ms = (args.timeout * 1000.0) as u64;
+    let base = zenoh_config.as_deref();
+    // A bad config file is its own error, not "cannot reach the run".
+    base_config(base)?;
     let session = match client {
-        true => open_client(std::slice::from_ref(&connect), timeout_ms),
+        true => open_client_from(base, std::slice::from_ref(&connect), timeout_ms),
         // Listening too: the nodes learn of the inspector through the broker (gossip) and connect to it, which is
         // how their status reaches it (peers do not forward for each other). Zenoh gossips the addresses of a
         // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for the inspector's few seconds only).
-        false => open_listening(
+        false => open_listening_from(
+            base,
             &["tcp/0.0.0.0:0".to_string()],
             std::slice::from_ref(&connect),
             timeout_ms,

@@ -170,6 +170,12 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if let Some(dir) = &args.restart {
         broker_args.extend(["--restart".into(), dir.display().to_string()]);
     }
+    // The zenoh config file (credentials, certificates) goes to every process started.
+    let zenoh_config: Vec<String> = match &args.zenoh_config {
+        Some(f) => vec!["--zenoh-config".into(), f.display().to_string()],
+        None => Vec::new(),
+    };
+    broker_args.extend(zenoh_config.iter().cloned());
     let mut broker = spawn("contact-broker", &broker_bin, &broker_args, &broker_log, Stdio::piped())?;
     let (tx, rx) = mpsc::channel();
     let stdout = broker.child.stdout.take().expect("piped stdout");
@@ -213,6 +219,7 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         run: info.run_id.clone(),
         connect: connect.clone(),
         client: args.connect.is_some(),
+        zenoh_config: args.zenoh_config.clone(),
         out: info.out.clone(),
         pid: std::process::id(),
     });
@@ -224,6 +231,7 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if args.connect.is_some() {
         node_args.push("--client".into());
     }
+    node_args.extend(zenoh_config);
     if let Some(n) = args.threads {
         node_args.extend(["--threads".into(), n.to_string()]);
     }

@@ -1,5 +1,6 @@
 //! The `cosim` command: launches a scene as processes or in one process (`run`), validates it (`check`),
-//! overlays a probe of several runs (`compare`), measures run time against error over a suite of scenes (`bench`).
+//! overlays a probe of several runs (`compare`), measures run time against error over a suite of scenes (`bench`),
+//! shows a running run's status (`inspect`), serves as the zenoh router of a run over several hosts (`router`).
 #![warn(missing_docs)]
 
 pub mod bench;
@@ -11,4 +12,5 @@ pub mod inspect;
 pub mod launch;
 pub mod progress;
 pub mod registry;
+pub mod router;
 pub mod run;

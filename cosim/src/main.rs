@@ -1,4 +1,4 @@
-//! `cosim`: run, check, compare, bench, inspect.
+//! `cosim`: run, check, compare, bench, inspect, router.
 
 use std::process::ExitCode;
 
@@ -20,6 +20,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => cosim::bench::bench(&args),
         Command::BenchRun(args) => cosim::bench::bench_run(&args),
         Command::Inspect(args) => cosim::inspect::inspect(&args),
+        Command::Router(args) => cosim::router::router(&args),
     };
     match result {
         Ok(code) => code,

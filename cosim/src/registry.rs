@@ -15,6 +15,9 @@ pub struct Entry {
     pub connect: String,
     /// Join as a zenoh client (the run goes through a router).
     pub client: bool,
+    /// The run's zenoh config file (`--zenoh-config`), which the inspector needs too (credentials, certificates).
+    #[serde(default)]
+    pub zenoh_config: Option<PathBuf>,
     /// Output folder.
     pub out: PathBuf,
     /// Process id of `cosim run`.

@@ -29,6 +29,18 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     if let Some(n) = args.threads {
         anyhow::ensure!(n >= 1, "--threads must be at least 1");
     }
+    // A zenoh config file that cannot be read or parsed is bad input, said once here rather than by each process.
+    let args = &match &args.zenoh_config {
+        Some(file) => {
+            cosim_bus::session::base_config(Some(file))?;
+            let absolute = std::path::absolute(file).with_context(|| format!("zenoh config {}", file.display()))?;
+            RunArgs {
+                zenoh_config: Some(absolute),
+                ..args.clone()
+            }
+        }
+        None => args.clone(),
+    };
     if let Some(node) = args.external {
         anyhow::ensure!(
             !args.in_process,

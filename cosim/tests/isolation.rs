@@ -1,9 +1,9 @@
 //! Two runs at once through one zenoh network never see each other's messages (`docs/PROTOCOL.md` §2: every key is
-//! under `cosim/<run>/`). A zenoh router opened by this test on loopback is the hub, as `zenohd` would be on a shared
-//! machine; two different coupled runs (the coarse gate with the particle–element contact, and with the
-//! particle–particle contact, so that their messages differ) run side by side as processes with `--connect` to it.
-//! Each must give the probes its own in-process run gives, byte for byte: one foreign message taken in would
-//! change them or fail the run.
+//! under `cosim/<run>/`). A zenoh router on loopback, started as its own process (`cosim router`, the router `zenohd`
+//! runs), is the hub, as `zenohd` would be on a shared machine; two different coupled runs (the coarse gate with the
+//! particle–element contact, and with the particle–particle contact, so that their messages differ) run side by side
+//! as processes with `--connect` to it. Each must give the probes its own in-process run gives, byte for byte: one
+//! foreign message taken in would change them or fail the run.
 
 mod common;
 
@@ -12,7 +12,6 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::*;
-use zenoh::Wait;
 
 const LIMIT: Duration = Duration::from_secs(300);
 const SCENE: &str = "scenes/elastic_gate.toml";
@@ -49,18 +48,9 @@ fn probes(out: &Path) -> Vec<u8> {
 #[test]
 fn two_runs_through_one_router_keep_to_themselves() {
     let dir = scratch("isolation");
-    let port = free_port();
-    let hub_endpoint = format!("tcp/127.0.0.1:{port}");
-    let mut config = zenoh::Config::default();
-    for (k, v) in [
-        ("mode", "\"router\"".to_string()),
-        ("scouting/multicast/enabled", "false".to_string()),
-        ("listen/endpoints", format!("[{hub_endpoint:?}]")),
-        ("connect/endpoints", "[]".to_string()),
-    ] {
-        config.insert_json5(k, &v).unwrap();
-    }
-    let hub = zenoh::open(config).wait().expect("open the hub");
+    let hub_endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let (hub, endpoints) = start_router(&hub_endpoint, None, &dir.join("router.stderr"));
+    assert_eq!(endpoints, std::slice::from_ref(&hub_endpoint));
 
     let out: Vec<PathBuf> = ["pe_hub", "pp_hub", "pe_alone", "pp_alone"]
         .iter()

@@ -41,3 +41,18 @@ pub fn client_settings(connect: &[String], timeout_ms: u64) -> Vec<(String, Stri
         ("connect/exit_on_failure".to_string(), "true".to_string()),
     ]
 }
+
+/// Settings of a router session (`cosim router`, the same router `zenohd` runs): the hub every client of a run
+/// spread over hosts connects to. Router mode, multicast scouting off, listen on `listen` (an endpoint that cannot
+/// be bound within `timeout_ms` is an error), connect to nothing.
+pub fn router_settings(listen: &[String], timeout_ms: u64) -> Vec<(String, String)> {
+    let quoted: Vec<String> = listen.iter().map(|e| format!("{e:?}")).collect();
+    vec![
+        ("mode".to_string(), "\"router\"".to_string()),
+        ("scouting/multicast/enabled".to_string(), "false".to_string()),
+        ("listen/endpoints".to_string(), format!("[{}]", quoted.join(","))),
+        ("listen/timeout_ms".to_string(), timeout_ms.to_string()),
+        ("listen/exit_on_failure".to_string(), "true".to_string()),
+        ("connect/endpoints".to_string(), "[]".to_string()),
+    ]
+}

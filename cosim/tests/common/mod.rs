@@ -123,3 +123,43 @@ pub fn wait_for_samples(run: &mut std::process::Child, out: &Path, n: usize, lim
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+/// `cosim router --listen ENDPOINT [--zenoh-config FILE]` as its own process, with its stderr in `log`; returns
+/// once it prints that it listens (within 20 s, else panics), with the endpoints it printed. Killed when dropped.
+pub fn start_router(endpoint: &str, zenoh_config: Option<&Path>, log: &Path) -> (Kill, Vec<String>) {
+    use std::io::BufRead;
+    let mut cmd = Command::new(cosim());
+    cmd.args(["router", "--listen", endpoint]);
+    if let Some(file) = zenoh_config {
+        cmd.arg("--zenoh-config").arg(file);
+    }
+    let mut router = Kill(
+        cmd.stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(std::fs::File::create(log).unwrap())
+            .spawn()
+            .unwrap(),
+    );
+    let stdout = router.0.stdout.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = std::io::BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(Duration::from_secs(20)).unwrap_or_default();
+    let v: serde_json::Value = serde_json::from_str(&line).unwrap_or_else(|_| {
+        panic!(
+            "cosim router did not say it listens (stdout {line:?}); stderr: {}",
+            std::fs::read_to_string(log).unwrap_or_default()
+        )
+    });
+    assert_eq!(v["event"], "listening", "{line}");
+    let endpoints = v["endpoints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_str().unwrap().to_string())
+        .collect();
+    (router, endpoints)
+}
