@@ -3,6 +3,7 @@
 //!
 //! Points carry z = 0: the simulation is 2D, ParaView is 3D.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use cosim_proto::messages::{FemMesh, FemSnapshot};
@@ -128,12 +129,23 @@ impl FrameWriter {
     }
 }
 
+/// Write the frame to a temporary file, streaming (the text of a frame is never held whole), then rename it.
 fn write_vtu(path: &Path, piece: UnstructuredGridPiece) -> Result<()> {
-    let bytes = match super::vtu::to_xml(&piece) {
-        Some(bytes) => bytes,
-        None => vtkio_xml(path, piece)?,
+    let Some(checked) = super::vtu::check(&piece) else {
+        let bytes = vtkio_xml(path, piece)?;
+        return write_atomic(path, &bytes);
     };
-    write_atomic(path, &bytes)
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    let file = std::fs::File::create(&tmp).map_err(|e| OutputError::io(&tmp, e))?;
+    let mut out = std::io::BufWriter::with_capacity(64 * 1024, file);
+    checked
+        .write(&mut out)
+        .and_then(|()| out.flush())
+        .map_err(|e| OutputError::io(&tmp, e))?;
+    drop(out);
+    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
 }
 
 /// The `.vtu` file as vtkio writes it (the reference the direct writer is tested against, and its fallback).

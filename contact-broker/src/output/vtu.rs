@@ -2,75 +2,149 @@
 //! for them (inline `binary` data arrays, base64 of a UInt64 byte count followed by the little-endian values, no
 //! whitespace), produced in one pass. vtkio's serde path takes 15–120 ms for a 26,000-particle frame; this one a
 //! few ms. Only the shapes [`super::vtk`] builds are handled (f64 points, `XML` connectivity and offsets, scalar and
-//! vector arrays of f64, u64, u32 or u8 with plain names); for anything else [`to_xml`] answers `None` and the
+//! vector arrays of f64, u64, u32 or u8 with plain names); for anything else [`check`] answers `None` and the
 //! caller falls back to vtkio. The tests compare the two byte for byte.
+
+use std::io::{self, Write};
 
 use vtkio::model::{Attribute, ElementType, IOBuffer, UnstructuredGridPiece, VertexNumbers};
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
-/// Standard base64 (with `=` padding) of `bytes`, appended to `out`.
-fn base64(bytes: &[u8], out: &mut Vec<u8>) {
-    out.reserve(bytes.len().div_ceil(3) * 4);
-    let mut chunks = bytes.chunks_exact(3);
-    for c in &mut chunks {
-        let n = u32::from(c[0]) << 16 | u32::from(c[1]) << 8 | u32::from(c[2]);
-        out.extend([18, 12, 6, 0].map(|s| B64[(n >> s & 63) as usize]));
-    }
-    match *chunks.remainder() {
-        [a] => {
-            let n = u32::from(a) << 16;
-            out.extend([B64[(n >> 18) as usize], B64[(n >> 12 & 63) as usize], b'=', b'=']);
+/// A streaming standard base64 encoder (with `=` padding): bytes go in as they come, the text goes out in blocks,
+/// so a data array is never held whole a second time (or a third, as text) while a frame is written.
+struct Base64<'w, W: Write> {
+    out: &'w mut W,
+    /// Bytes waiting for a full group of three.
+    pending: [u8; 3],
+    held: usize,
+    text: Vec<u8>,
+}
+
+impl<'w, W: Write> Base64<'w, W> {
+    const BLOCK: usize = 16 * 1024;
+
+    fn new(out: &'w mut W) -> Self {
+        Self {
+            out,
+            pending: [0; 3],
+            held: 0,
+            text: Vec::with_capacity(Self::BLOCK + 4),
         }
-        [a, b] => {
-            let n = u32::from(a) << 16 | u32::from(b) << 8;
-            out.extend([
+    }
+
+    fn group(&mut self, c: [u8; 3]) {
+        let n = u32::from(c[0]) << 16 | u32::from(c[1]) << 8 | u32::from(c[2]);
+        self.text.extend([18, 12, 6, 0].map(|s| B64[(n >> s & 63) as usize]));
+    }
+
+    fn push(&mut self, mut bytes: &[u8]) -> io::Result<()> {
+        while self.held > 0 && !bytes.is_empty() {
+            self.pending[self.held] = bytes[0];
+            self.held += 1;
+            bytes = &bytes[1..];
+            if self.held == 3 {
+                self.held = 0;
+                self.group(self.pending);
+            }
+        }
+        let mut groups = bytes.chunks_exact(3);
+        for c in &mut groups {
+            self.group([c[0], c[1], c[2]]);
+            if self.text.len() >= Self::BLOCK {
+                self.out.write_all(&self.text)?;
+                self.text.clear();
+            }
+        }
+        for &b in groups.remainder() {
+            self.pending[self.held] = b;
+            self.held += 1;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> io::Result<()> {
+        let n = u32::from(self.pending[0]) << 16 | u32::from(self.pending[1]) << 8;
+        match self.held {
+            1 => self
+                .text
+                .extend([B64[(n >> 18) as usize], B64[(n >> 12 & 63) as usize], b'=', b'=']),
+            2 => self.text.extend([
                 B64[(n >> 18) as usize],
                 B64[(n >> 12 & 63) as usize],
                 B64[(n >> 6 & 63) as usize],
                 b'=',
-            ]);
+            ]),
+            _ => {}
         }
-        _ => {}
+        self.out.write_all(&self.text)
     }
 }
 
-/// VTK type name and little-endian bytes of a buffer; `None` for types the frames never hold.
-fn raw(buf: &IOBuffer) -> Option<(&'static str, Vec<u8>)> {
+/// Standard base64 (with `=` padding) of `bytes`, appended to `out`.
+#[cfg(test)]
+fn base64(bytes: &[u8], out: &mut Vec<u8>) {
+    let mut enc = Base64::new(out);
+    enc.push(bytes).expect("writing to memory");
+    enc.finish().expect("writing to memory");
+}
+
+/// VTK type name and byte count of a buffer; `None` for types the frames never hold.
+fn kind(buf: &IOBuffer) -> Option<(&'static str, usize)> {
     Some(match buf {
-        IOBuffer::F64(v) => ("Float64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        IOBuffer::U64(v) => ("UInt64", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        IOBuffer::U32(v) => ("UInt32", v.iter().flat_map(|x| x.to_le_bytes()).collect()),
-        IOBuffer::U8(v) => ("UInt8", v.clone()),
+        IOBuffer::F64(v) => ("Float64", 8 * v.len()),
+        IOBuffer::U64(v) => ("UInt64", 8 * v.len()),
+        IOBuffer::U32(v) => ("UInt32", 4 * v.len()),
+        IOBuffer::U8(v) => ("UInt8", v.len()),
         _ => return None,
     })
 }
 
-/// `<DataArray …>base64</DataArray>`; `name` is omitted for the points.
-fn array(out: &mut Vec<u8>, name: Option<&str>, components: u32, buf: &IOBuffer) -> Option<()> {
-    let (ty, bytes) = raw(buf)?;
-    if bytes.is_empty() {
-        return None;
+/// The little-endian bytes of the values, into the encoder a few thousand at a time.
+fn values<W: Write>(enc: &mut Base64<'_, W>, buf: &IOBuffer) -> io::Result<()> {
+    fn each<W: Write, const N: usize, T: Copy>(
+        enc: &mut Base64<'_, W>,
+        v: &[T],
+        le: impl Fn(T) -> [u8; N],
+    ) -> io::Result<()> {
+        let mut block = Vec::with_capacity(N * 1024);
+        for chunk in v.chunks(1024) {
+            block.clear();
+            block.extend(chunk.iter().flat_map(|&x| le(x)));
+            enc.push(&block)?;
+        }
+        Ok(())
     }
-    out.extend_from_slice(format!("<DataArray type=\"{ty}\"").as_bytes());
-    if let Some(name) = name {
-        out.extend_from_slice(format!(" Name=\"{name}\"").as_bytes());
+    match buf {
+        IOBuffer::F64(v) => each(enc, v, f64::to_le_bytes),
+        IOBuffer::U64(v) => each(enc, v, u64::to_le_bytes),
+        IOBuffer::U32(v) => each(enc, v, u32::to_le_bytes),
+        IOBuffer::U8(v) => enc.push(v),
+        _ => unreachable!("checked by `kind`"),
     }
-    out.extend_from_slice(format!(" format=\"binary\" NumberOfComponents=\"{components}\">").as_bytes());
-    let mut block = Vec::with_capacity(8 + bytes.len());
-    block.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
-    block.extend_from_slice(&bytes);
-    base64(&block, out);
-    out.extend_from_slice(b"</DataArray>");
-    Some(())
 }
 
-/// `<PointData …>` or `<CellData …>` with its arrays (`<Tag/>` when there are none).
-fn attributes(out: &mut Vec<u8>, tag: &str, attrs: &[Attribute]) -> Option<()> {
-    if attrs.is_empty() {
-        out.extend_from_slice(format!("<{tag}/>").as_bytes());
-        return Some(());
+/// `<DataArray …>base64</DataArray>`; `name` is omitted for the points. The buffer's kind is checked first.
+fn array<W: Write>(out: &mut W, name: Option<&str>, components: u32, buf: &IOBuffer) -> io::Result<()> {
+    let (ty, len) = kind(buf).expect("checked by `check`");
+    write!(out, "<DataArray type=\"{ty}\"")?;
+    if let Some(name) = name {
+        write!(out, " Name=\"{name}\"")?;
     }
+    write!(out, " format=\"binary\" NumberOfComponents=\"{components}\">")?;
+    let mut enc = Base64::new(out);
+    // vtkio's binary block: a UInt64 byte count, then the values.
+    enc.push(&(len as u64).to_le_bytes())?;
+    values(&mut enc, buf)?;
+    enc.finish()?;
+    out.write_all(b"</DataArray>")
+}
+
+/// The arrays of a `<PointData>` or `<CellData>`: (name, components, data), and the active scalar and vector
+/// names; `None` for what this writer does not handle.
+type Arrays<'a> = (Vec<(&'a str, u32, &'a IOBuffer)>, Option<&'a str>, Option<&'a str>);
+
+fn arrays(attrs: &[Attribute]) -> Option<Arrays<'_>> {
     let (mut scalars, mut vectors) = (None, None);
     let mut arrays = Vec::with_capacity(attrs.len());
     for a in attrs {
@@ -95,56 +169,94 @@ fn attributes(out: &mut Vec<u8>, tag: &str, attrs: &[Attribute]) -> Option<()> {
             }
             _ => return None,
         };
+        if kind(&d.data)?.1 == 0 {
+            return None;
+        }
         arrays.push((d.name.as_str(), components, &d.data));
     }
-    out.extend_from_slice(format!("<{tag}").as_bytes());
+    Some((arrays, scalars, vectors))
+}
+
+/// `<PointData …>` or `<CellData …>` with its arrays (`<Tag/>` when there are none).
+fn attributes<W: Write>(out: &mut W, tag: &str, (arrays, scalars, vectors): Arrays<'_>) -> io::Result<()> {
+    if arrays.is_empty() {
+        return write!(out, "<{tag}/>");
+    }
+    write!(out, "<{tag}")?;
     if let Some(s) = scalars {
-        out.extend_from_slice(format!(" Scalars=\"{s}\"").as_bytes());
+        write!(out, " Scalars=\"{s}\"")?;
     }
     if let Some(v) = vectors {
-        out.extend_from_slice(format!(" Vectors=\"{v}\"").as_bytes());
+        write!(out, " Vectors=\"{v}\"")?;
     }
-    out.push(b'>');
+    out.write_all(b">")?;
     for (name, components, data) in arrays {
         array(out, Some(name), components, data)?;
     }
-    out.extend_from_slice(format!("</{tag}>").as_bytes());
-    Some(())
+    write!(out, "</{tag}>")
 }
 
-/// The `.vtu` file of `piece` as vtkio writes it (XML format 1.0, little endian, UInt64 headers), or `None` when
-/// the piece holds something this writer does not handle.
-pub(crate) fn to_xml(piece: &UnstructuredGridPiece) -> Option<Vec<u8>> {
+/// A piece this writer can write: its point and cell arrays and its connectivity.
+pub(crate) struct Checked<'a> {
+    piece: &'a UnstructuredGridPiece,
+    point: Arrays<'a>,
+    cell: Arrays<'a>,
+    connectivity: IOBuffer,
+    offsets: IOBuffer,
+}
+
+/// Whether `piece` has the shape this writer handles (f64 points, `XML` connectivity, named scalar and vector arrays
+/// of f64, u64, u32 or u8, none empty); `None` when the caller should fall back to vtkio.
+pub(crate) fn check(piece: &UnstructuredGridPiece) -> Option<Checked<'_>> {
     let VertexNumbers::XML { connectivity, offsets } = &piece.cells.cell_verts else {
         return None;
     };
-    if !matches!(piece.points, IOBuffer::F64(_)) {
+    if !matches!(piece.points, IOBuffer::F64(_)) || piece.points.is_empty() || connectivity.is_empty() {
         return None;
     }
-    let points = piece.points.len() / 3;
-    let cells = piece.cells.types.len();
-    let mut out = Vec::with_capacity(64 * 1024 + 4 * (32 * points + 17 * cells));
-    out.extend_from_slice(
-        b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
-          <UnstructuredGrid>",
-    );
-    out.extend_from_slice(
-        format!(
+    Some(Checked {
+        piece,
+        point: arrays(&piece.data.point)?,
+        cell: arrays(&piece.data.cell)?,
+        connectivity: IOBuffer::U64(connectivity.clone()),
+        offsets: IOBuffer::U64(offsets.clone()),
+    })
+}
+
+impl Checked<'_> {
+    /// Write the `.vtu` file as vtkio writes it (XML format 1.0, little endian, UInt64 headers), streaming.
+    pub(crate) fn write<W: Write>(self, out: &mut W) -> io::Result<()> {
+        let piece = self.piece;
+        let points = piece.points.len() / 3;
+        let cells = piece.cells.types.len();
+        out.write_all(
+            b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
+              <UnstructuredGrid>",
+        )?;
+        write!(
+            out,
             "<Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" \
              NumberOfPolys=\"0\" NumberOfVerts=\"0\">"
-        )
-        .as_bytes(),
-    );
-    attributes(&mut out, "PointData", &piece.data.point)?;
-    attributes(&mut out, "CellData", &piece.data.cell)?;
-    out.extend_from_slice(b"<Points>");
-    array(&mut out, None, 3, &piece.points)?;
-    out.extend_from_slice(b"</Points><Cells>");
-    array(&mut out, Some("connectivity"), 1, &IOBuffer::U64(connectivity.clone()))?;
-    array(&mut out, Some("offsets"), 1, &IOBuffer::U64(offsets.clone()))?;
-    let types: Vec<u8> = piece.cells.types.iter().map(|&t| t as u8).collect();
-    array(&mut out, Some("types"), 1, &IOBuffer::U8(types))?;
-    out.extend_from_slice(b"</Cells></Piece></UnstructuredGrid></VTKFile>");
+        )?;
+        attributes(out, "PointData", self.point)?;
+        attributes(out, "CellData", self.cell)?;
+        out.write_all(b"<Points>")?;
+        array(out, None, 3, &piece.points)?;
+        out.write_all(b"</Points><Cells>")?;
+        array(out, Some("connectivity"), 1, &self.connectivity)?;
+        array(out, Some("offsets"), 1, &self.offsets)?;
+        let types: Vec<u8> = piece.cells.types.iter().map(|&t| t as u8).collect();
+        array(out, Some("types"), 1, &IOBuffer::U8(types))?;
+        out.write_all(b"</Cells></Piece></UnstructuredGrid></VTKFile>")
+    }
+}
+
+/// The `.vtu` file of `piece` in memory (tests compare it with vtkio's), or `None` when the piece holds something
+/// this writer does not handle.
+#[cfg(test)]
+pub(crate) fn to_xml(piece: &UnstructuredGridPiece) -> Option<Vec<u8>> {
+    let mut out = Vec::new();
+    check(piece)?.write(&mut out).expect("writing to memory");
     Some(out)
 }
 
