@@ -127,6 +127,12 @@ pub struct FluidSpec {
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ppe_source: Option<PpeSourceKind>,
+    /// Safety factor on the fluid's stable step: the node steps at `cfl` times the step of `DESIGN.md` §4.2
+    /// (WCSPH: min of the acoustic, force and viscous limits) or §4.3 (ISPH: C h / v_max with the same force and
+    /// viscous limits). In (0, 1], default 1 (the limit itself); a value above 1 is refused, since the limit is
+    /// already the largest step the schemes are stable at. Not written to `scene.toml` when 1.
+    #[serde(default = "default_fluid_cfl", skip_serializing_if = "is_default_fluid_cfl")]
+    pub cfl: f64,
     /// Regions filled with particles at rest (`[[fluid.block]]`).
     #[serde(rename = "block")]
     pub blocks: Vec<BoxSpec>,
@@ -150,6 +156,14 @@ fn default_filter_interval() -> u32 {
 
 fn default_xsph() -> f64 {
     0.5
+}
+
+fn default_fluid_cfl() -> f64 {
+    1.0
+}
+
+fn is_default_fluid_cfl(cfl: &f64) -> bool {
+    *cfl == default_fluid_cfl()
 }
 
 impl FluidSpec {
@@ -742,6 +756,17 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Res
     if let Some(c) = f.sound_speed {
         finite_positive("fluid.sound_speed", c)?;
     }
+    check(
+        f.cfl.is_finite() && f.cfl > 0.0 && f.cfl <= 1.0,
+        || "fluid.cfl".into(),
+        || {
+            format!(
+                "must be in (0, 1] (a factor on the stable step of DESIGN.md §4.2/§4.3; above 1 the fluid is \
+                 stepped past its stability limit), got {}",
+                f.cfl
+            )
+        },
+    )?;
     check(
         f.artificial_viscosity.is_finite() && f.artificial_viscosity >= 0.0,
         || "fluid.artificial_viscosity".into(),

@@ -68,3 +68,21 @@ fn resolved_scene_round_trips_through_toml() {
     let again = parse("resolved", &s.to_toml(), &[]).unwrap();
     assert_eq!(s, again);
 }
+
+#[test]
+fn fluid_cfl_defaults_to_one_and_is_refused_above_one() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/dam_break.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("d.toml", &text, &[]).unwrap();
+    assert_eq!(s.fluid.as_ref().unwrap().cfl, 1.0);
+    // At the default the resolved scene is written as before (checkpoints compare it line by line).
+    assert!(!s.to_toml().lines().any(|l| l.starts_with("cfl")));
+    let s = parse("d.toml", &text, &["fluid.cfl=0.9".into()]).unwrap();
+    assert_eq!(s.fluid.as_ref().unwrap().cfl, 0.9);
+    assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    for bad in ["1.1", "0", "-0.5", "nan"] {
+        let e = err(&text, &[&format!("fluid.cfl={bad}")]);
+        assert!(e.starts_with("f.toml: fluid.cfl: must be in (0, 1]"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}

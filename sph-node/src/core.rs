@@ -16,8 +16,9 @@ use crate::particles::{FluidState, WallParticles};
 use crate::solver::{SphParams, WcsphSolver};
 use crate::stability::EnergyGuard;
 
-/// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9).
-const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 1);
+/// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9). Version 2: the
+/// solvers carry `fluid.cfl`.
+const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 2);
 
 /// The fluid solver the scene asks for.
 #[derive(Serialize, Deserialize)]

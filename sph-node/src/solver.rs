@@ -125,6 +125,8 @@ pub struct WcsphSolver {
     sorted: Sorted,
     /// `state` was handed out mutably ([`WcsphSolver::state_mut`]): the next step re-reads it.
     state_edited: bool,
+    /// Factor on the stable step of §4.2 (`fluid.cfl`, in (0, 1]; 1 unless the scene says otherwise).
+    cfl: f64,
     scratch: Scratch,
 }
 
@@ -203,7 +205,9 @@ impl WcsphSolver {
             apd: spec.apd,
             central_force: 0.0,
         };
-        Self::from_particles(params, options, state, walls)
+        let mut solver = Self::from_particles(params, options, state, walls)?;
+        solver.cfl = spec.cfl;
+        Ok(solver)
     }
 
     /// A solver on given particles (tests, e.g. the oscillating drop, whose circle the scene's blocks cannot
@@ -265,6 +269,7 @@ impl WcsphSolver {
             accel: vec![[0.0; 2]; n],
             sorted,
             state_edited: false,
+            cfl: 1.0,
             scratch,
         };
         solver.check(0)?;
@@ -325,12 +330,13 @@ impl WcsphSolver {
         &self.accel
     }
 
-    /// Stable step of §4.2 for the current state.
+    /// Stable step of §4.2 for the current state, times the scene's `fluid.cfl` (1 by default, and for a
+    /// solver built by [`WcsphSolver::from_particles`]).
     pub fn stable_dt(&self) -> f64 {
         // From the id-ordered copies, which also hold any edit made through `state_mut`.
         let v_max = max_norm(&self.state.v);
         let a_max = max_norm(&self.accel);
-        time_step::stable_dt(self.params.h, self.params.c0, v_max, a_max, self.params.nu)
+        self.cfl * time_step::stable_dt(self.params.h, self.params.c0, v_max, a_max, self.params.nu)
     }
 
     /// Σ ½ m |v|² (per unit depth).

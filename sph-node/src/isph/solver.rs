@@ -89,6 +89,8 @@ pub struct IsphSolver {
     wall_boxes: WallBoxes,
     /// The unit normal of each wall particle ([`super::wall_normal`]).
     wall_normals: Vec<[f64; 2]>,
+    /// Factor on the step of §4.3 (`fluid.cfl`, in (0, 1]; 1 unless the scene says otherwise).
+    cfl: f64,
     scratch: Scratch,
 }
 
@@ -212,6 +214,7 @@ impl IsphSolver {
             contact: ContactLayer::default(),
             wall_boxes,
             wall_normals,
+            cfl: spec.cfl,
             scratch: Scratch::default(),
         };
         solver.contact.record_end(&solver.state);
@@ -261,7 +264,7 @@ impl IsphSolver {
 
     /// Δt = min(C h / max(v_max, sqrt(2 |g| H)), 0.25 sqrt(h/a_max), 0.125 h²/ν) (`DESIGN.md` §4.3, step 6, with
     /// the force and viscous limits of §4.2; H is the initial fluid depth, a_max the largest acceleration of the
-    /// last step, at least |g|).
+    /// last step, at least |g|), times the scene's `fluid.cfl` (1 by default).
     pub fn stable_dt(&self) -> f64 {
         let h = self.params.h;
         let v_max = self
@@ -281,11 +284,12 @@ impl IsphSolver {
         if self.params.nu > 0.0 {
             dt = dt.min(0.125 * h * h / self.params.nu); // §4.2 viscous condition
         }
-        if dt.is_finite() {
-            dt
-        } else {
-            0.25 * h // no motion, no force: any step; keep it finite
-        }
+        self.cfl
+            * if dt.is_finite() {
+                dt
+            } else {
+                0.25 * h // no motion, no force: any step; keep it finite
+            }
     }
 
     /// Σ ½ m |v|² (per unit depth).
