@@ -267,9 +267,13 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             _ => {}
         }
     };
-    // The broker told the nodes to stop; give them a moment to exit, then make sure.
+    // After a run that ended well the broker told the nodes to stop; after a failure a live node sees the broker's
+    // token go within a fraction of a second, and one that does not (frozen, or the one that failed) is stopped
+    // here. Give them a moment to exit, then make sure.
+    let grace = if broker_status.success() { 5 } else { 2 };
+    let until = Instant::now() + Duration::from_secs(grace);
     for node in &mut nodes {
-        node.wait_for(Duration::from_secs(5));
+        node.wait_for(until.saturating_duration_since(Instant::now()));
     }
     drop(nodes);
 
