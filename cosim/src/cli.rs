@@ -146,7 +146,8 @@ pub struct BenchArgs {
     /// Output folder: bench.json, report.md, pareto.svg, and each case's run under runs/.
     #[arg(long)]
     pub out: PathBuf,
-    /// Run only these cases (dam_break, hydrostatic_plate, elastic_gate, scaling; repeatable or comma-separated).
+    /// Run only these cases (dam_break, hydrostatic_plate, elastic_gate, scaling, stress; repeatable or
+    /// comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
     /// Run only these fluid solvers (wcsph, isph).
@@ -155,10 +156,10 @@ pub struct BenchArgs {
     /// Run the gate only with these contact algorithms (particle_element, particle_particle).
     #[arg(long, value_delimiter = ',')]
     pub contact: Vec<String>,
-    /// Replace the suite's spacings [m] of every case but scaling.
+    /// Replace the suite's spacings [m] of every case but scaling and stress.
     #[arg(long, value_delimiter = ',')]
     pub spacing: Vec<f64>,
-    /// Replace the suite's end time [s] of every case but scaling.
+    /// Replace the suite's end time [s] of every case but scaling and stress.
     #[arg(long)]
     pub end_time: Option<f64>,
     /// Folder of the scenes and their reference data.

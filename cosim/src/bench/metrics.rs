@@ -10,6 +10,10 @@
 //!   the first overshoot) against w = q L⁴ / (384 D) = −6.86e-5 m; `error` = |w̄ − w| / |w|.
 //! * Elastic gate (as `cosim/tests/fsi.rs`): the largest horizontal displacement of the free end against the
 //!   published 0.043 m (SPH–FEM and SPH results span 0.039–0.043 m); `error` = |peak − 0.043| / 0.043.
+//! * Stress: no error; the fluid's total energy (probe `energy`, 0 at t = 0) against the budget E_b = ρ0 |g| Σ W H²/2
+//!   of the scene's fluid blocks as run (`DIR/scene.toml`): `energy_growth` = max E / E_b (energy the scheme
+//!   created), `energy_drift` = E(end) / E_b (negative: dissipated). Measured whatever the status, up to where the
+//!   run stopped.
 
 use std::path::Path;
 
@@ -43,6 +47,10 @@ pub struct Measured {
     pub value: Option<f64>,
     /// Reference value.
     pub reference: Option<f64>,
+    /// Largest fluid energy over the budget (stress cases).
+    pub energy_growth: Option<f64>,
+    /// Fluid energy at the end over the budget (stress cases).
+    pub energy_drift: Option<f64>,
 }
 
 /// Measure the run in `out` (scene folder `scenes` for the reference data) at `spacing`.
@@ -76,7 +84,34 @@ pub fn measure(metric: Metric, out: &Path, scenes: &Path, spacing: f64) -> anyho
             })
         }
         Metric::Scaling => Ok(Measured::default()),
+        Metric::Stress => stress(out),
     }
+}
+
+fn stress(out: &Path) -> anyhow::Result<Measured> {
+    let path = out.join("scene.toml");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let scene = cosim_proto::scene::parse(&path.display().to_string(), &text, &[])?;
+    let fluid = scene.fluid.context("the scene has no fluid")?;
+    let g = scene.run.gravity[0].hypot(scene.run.gravity[1]);
+    let budget: f64 = fluid
+        .blocks
+        .iter()
+        .map(|b| {
+            let (w, h) = (b.max[0] - b.min[0], b.max[1] - b.min[1]);
+            fluid.density * g * w * h * h / 2.0
+        })
+        .sum();
+    let energy = read_probe(out, "energy")?;
+    if energy.is_empty() || budget <= 0.0 {
+        bail!("no energy sample or no energy budget");
+    }
+    let growth = energy.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    Ok(Measured {
+        energy_growth: Some(growth / budget),
+        energy_drift: Some(energy[energy.len() - 1].1 / budget),
+        ..Measured::default()
+    })
 }
 
 fn dam_break(out: &Path, scenes: &Path, spacing: f64) -> anyhow::Result<Measured> {
@@ -116,8 +151,7 @@ fn dam_break(out: &Path, scenes: &Path, spacing: f64) -> anyhow::Result<Measured
     Ok(Measured {
         error: Some(errors.iter().sum::<f64>() / errors.len() as f64),
         error_max: Some(errors.iter().copied().fold(0.0, f64::max)),
-        value: None,
-        reference: None,
+        ..Measured::default()
     })
 }
 

@@ -115,12 +115,20 @@ fn progress_line(r: &record::Record) -> String {
     } else {
         String::new()
     };
+    let variant = if r.variant.is_empty() {
+        String::new()
+    } else {
+        format!(" {}", r.variant)
+    };
     let mut line = format!(
-        "{} {}{contact}{threads} dx={}: {}, {} particles, {} steps, {:.2} s, {:.2e} particle-steps/s",
+        "{}{variant} {}{contact}{threads} dx={}: {}, {} particles, {} steps, {:.2} s, {:.2e} particle-steps/s",
         r.case, r.solver, r.spacing, r.status, r.particles, r.steps, r.wall_seconds, r.particle_steps_per_second
     );
     if let Some(e) = r.error {
         line += &format!(", error {:.2} %", 100.0 * e);
+    }
+    if let (Some(g), Some(d)) = (r.energy_growth, r.energy_drift) {
+        line += &format!(", energy max {g:+.4} end {d:+.4} of the budget");
     }
     if let Some(b) = r.peak_rss_bytes {
         line += &format!(", peak RSS {:.1} MB", b as f64 / 1048576.0);

@@ -8,8 +8,11 @@ use serde::{Deserialize, Serialize};
 /// One bench case's result. A case that failed or blew up is a record too, with `status` and `message`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Record {
-    /// `dam_break` | `hydrostatic_plate` | `elastic_gate` | `scaling`.
+    /// `dam_break` | `hydrostatic_plate` | `elastic_gate` | `scaling` | `stress`.
     pub case: String,
+    /// Which stress test; empty for the other cases.
+    #[serde(default)]
+    pub variant: String,
     /// `wcsph` | `isph`.
     pub solver: String,
     /// `particle_element` | `particle_particle` | `none` (no structure).
@@ -48,6 +51,13 @@ pub struct Record {
     pub value: Option<f64>,
     /// The reference value (`null` for a curve).
     pub reference: Option<f64>,
+    /// Stress cases: the fluid's largest total energy over its budget ρ0 g Σ W H²/2 (energy the scheme created;
+    /// 0 at t = 0); `null` for the other cases.
+    #[serde(default)]
+    pub energy_growth: Option<f64>,
+    /// Stress cases: the fluid's total energy at the end over its budget (negative: dissipated).
+    #[serde(default)]
+    pub energy_drift: Option<f64>,
     /// How `error` is computed.
     pub metric: String,
     /// Peak resident memory of the run's process (VmHWM) [bytes].

@@ -45,6 +45,7 @@ pub fn render(ctx: &Context, records: &[Record]) -> String {
     );
     cases_section(&mut md, ctx.cases);
     results_section(&mut md, records);
+    stress_section(&mut md, records);
     scaling_section(&mut md, records);
     let failed: Vec<&Record> = records.iter().filter(|r| r.status != "ok").collect();
     if !failed.is_empty() {
@@ -119,6 +120,10 @@ fn cases_section(md: &mut String, cases: &[Case]) {
                 Metric::Gate => {
                     " (published SPH–FEM and SPH peaks span 0.039–0.043 m); `error` = |peak − 0.043| / 0.043"
                 }
+                Metric::Stress => {
+                    "; each must end `ok` with every probe sample finite and `energy_growth` ≤ 0.05 (the bound of \
+                     `cosim/tests/stress.rs`), or be stopped `unstable` by a guard with a reason"
+                }
                 Metric::Scaling => {
                     "; the WCSPH dam break at ~5,000 to ~100,000 particles for ~60 steps (quick) or ~200 (full), \
                      one frame at the start and one at the end"
@@ -141,7 +146,10 @@ fn dedup(items: impl Iterator<Item = String>) -> Vec<String> {
 }
 
 fn results_section(md: &mut String, records: &[Record]) {
-    let rows: Vec<&Record> = records.iter().filter(|r| r.case != "scaling").collect();
+    let rows: Vec<&Record> = records
+        .iter()
+        .filter(|r| r.case != "scaling" && r.case != "stress")
+        .collect();
     if rows.is_empty() {
         return;
     }
@@ -175,6 +183,42 @@ fn results_section(md: &mut String, records: &[Record]) {
         );
     }
     md.push_str("\nThe same as `pareto.svg`: error against wall time, one curve per case, solver and contact.\n\n");
+}
+
+fn stress_section(md: &mut String, records: &[Record]) {
+    let rows: Vec<&Record> = records.iter().filter(|r| r.case == "stress").collect();
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## Stress tests\n");
+    let _ = writeln!(
+        md,
+        "Energy as a fraction of the budget ρ0 g Σ W H²/2: `growth` the largest, `end` the last sample (negative: \
+         dissipated).\n"
+    );
+    let _ = writeln!(
+        md,
+        "| stress test | solver | Δx [m] | end [s] | steps | wall [s] | status | energy growth | energy end | message |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let f = |v: Option<f64>| v.map_or("–".into(), |v| format!("{v:+.4}"));
+    for r in rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} |",
+            r.variant,
+            r.solver,
+            r.spacing,
+            r.end_time,
+            r.steps,
+            r.wall_seconds,
+            r.status,
+            f(r.energy_growth),
+            f(r.energy_drift),
+            if r.status == "ok" { "" } else { r.message.as_str() }
+        );
+    }
+    md.push('\n');
 }
 
 fn cpu(seconds: Option<f64>) -> String {

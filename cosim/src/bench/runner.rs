@@ -33,6 +33,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         .unwrap_or_default();
     let mut record = Record {
         case: case.case.into(),
+        variant: case.variant.into(),
         solver: case.solver.into(),
         contact: case.contact.into(),
         spacing: case.spacing,
@@ -52,6 +53,8 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         error_max: None,
         value: None,
         reference: None,
+        energy_growth: None,
+        energy_drift: None,
         metric: super::suite::describe(case.metric).into(),
         peak_rss_bytes: stats.peak_rss_bytes,
         cpu_seconds: stats.cpu_seconds,
@@ -88,7 +91,24 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         }
         Outcome::Exited => {}
     }
-    if record.status == "ok" {
+    if case.metric == super::suite::Metric::Stress && summary.is_some() {
+        // Whatever the status: a run a guard stopped has its energy up to the stop.
+        match metrics::measure(case.metric, out, scenes, case.spacing) {
+            Ok(m) => {
+                record.energy_growth = m.energy_growth;
+                record.energy_drift = m.energy_drift;
+            }
+            Err(e) if record.status == "ok" => {
+                record.status = "failed".into();
+                record.message = format!("cannot measure: {e:#}");
+            }
+            Err(_) => {}
+        }
+        if record.status == "ok" && !record.energy_growth.is_some_and(f64::is_finite) {
+            record.status = "failed".into();
+            record.message = "status ok but the energy is not finite".into();
+        }
+    } else if record.status == "ok" {
         match metrics::measure(case.metric, out, scenes, case.spacing) {
             Ok(m) => {
                 record.error = m.error;

@@ -17,13 +17,17 @@ pub enum Metric {
     Gate,
     /// No error: cost per particle-step only.
     Scaling,
+    /// No error: status and the fluid's energy against its budget (stress tests of numerical stability).
+    Stress,
 }
 
 /// One run of the suite.
 #[derive(Clone, Debug)]
 pub struct Case {
-    /// `dam_break` | `hydrostatic_plate` | `elastic_gate` | `scaling`.
+    /// `dam_break` | `hydrostatic_plate` | `elastic_gate` | `scaling` | `stress`.
     pub case: &'static str,
+    /// Which stress test (`still_tank`, `tall_dam_break`, …); empty for the other cases.
+    pub variant: &'static str,
     /// Scene file.
     pub scene: PathBuf,
     /// `wcsph` | `isph`.
@@ -68,7 +72,15 @@ impl Case {
             _ => "",
         };
         let threads = self.threads.map(|n| format!("_t{n}")).unwrap_or_default();
-        format!("{}_{}{contact}_dx{}{threads}", self.case, self.solver, self.spacing)
+        let variant = if self.variant.is_empty() {
+            String::new()
+        } else {
+            format!("_{}", self.variant)
+        };
+        format!(
+            "{}{variant}_{}{contact}_dx{}{threads}",
+            self.case, self.solver, self.spacing
+        )
     }
 }
 
@@ -83,14 +95,14 @@ pub struct Selection {
     pub solvers: Vec<String>,
     /// Contact algorithms to run on the gate (empty: both).
     pub contacts: Vec<String>,
-    /// Spacings replacing the suite's own for every case but scaling (empty: the suite's).
+    /// Spacings replacing the suite's own for every case but scaling and stress (empty: the suite's).
     pub spacings: Vec<f64>,
-    /// End time replacing the suite's own for every case but scaling.
+    /// End time replacing the suite's own for every case but scaling and stress.
     pub end_time: Option<f64>,
 }
 
 /// The case names, in suite order.
-pub const CASES: [&str; 4] = ["dam_break", "hydrostatic_plate", "elastic_gate", "scaling"];
+pub const CASES: [&str; 5] = ["dam_break", "hydrostatic_plate", "elastic_gate", "scaling", "stress"];
 
 /// Scaling: the dam-break column at these spacings is ~5,000, 20,000, 50,000 and 100,000 particles
 /// (0.1 m × 0.2 m / Δx²).
@@ -119,6 +131,7 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
         for &spacing in spacings {
             cases.push(Case {
                 case,
+                variant: "",
                 scene: scenes.join(format!("{case}.toml")),
                 solver,
                 contact,
@@ -183,6 +196,7 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
         for &spacing in &SCALING_SPACINGS {
             cases.push(Case {
                 case: "scaling",
+                variant: "",
                 scene: scenes.join("dam_break.toml"),
                 solver: "wcsph",
                 contact: "none",
@@ -195,6 +209,7 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
             });
         }
     }
+    cases.extend(stress(scenes, q));
     let wanted = |list: &[String], v: &str| list.is_empty() || list.iter().any(|w| w == v);
     cases.retain(|c| {
         wanted(&sel.only, c.case)
@@ -220,5 +235,111 @@ pub fn describe(metric: Metric) -> &'static str {
         Metric::Plate => "mean mid-span deflection (probe `mid_uy`) over 0.05 s < t ≤ end against −6.86e-5 m",
         Metric::Gate => "peak horizontal displacement of the free end (probe `tip_x`) against 0.043 m",
         Metric::Scaling => "no error: fluid cost per particle-step",
+        Metric::Stress => {
+            "no error: status, and the fluid's energy (probe `energy`) against its budget E_b = ρ0 g Σ W H²/2"
+        }
     }
+}
+
+/// The tall dam break of the stress tests (`cosim/tests/stress.rs`): the dam-break scene with a 0.1 m × 0.3 m
+/// column in a closed tank 0.3 m wide and 0.6 m high, walls 0.03 m thick.
+const TALL_DAM_BREAK: [&str; 8] = [
+    "fluid.block.max=[0.1,0.3]",
+    "wall[0].min=[-0.03,-0.03]",
+    "wall[0].max=[0.33,0.0]",
+    "wall[1].min=[-0.03,0.0]",
+    "wall[1].max=[0.0,0.6]",
+    "wall[2].min=[0.3,0.0]",
+    "wall[2].max=[0.33,0.6]",
+    "run.output_interval=0.01",
+];
+
+/// The still tank of the stress tests: 0.3 m wide, 0.5 m deep (as `sph-node/tests/still_water_long.rs`), with a
+/// kinetic-energy probe in place of the second front probe.
+const STILL_TANK: [&str; 10] = [
+    "fluid.block.max=[0.3,0.5]",
+    "wall[0].min=[-0.075,-0.075]",
+    "wall[0].max=[0.375,0.0]",
+    "wall[1].min=[-0.075,0.0]",
+    "wall[1].max=[0.0,0.6]",
+    "wall[2].min=[0.3,0.0]",
+    "wall[2].max=[0.375,0.6]",
+    "run.output_interval=0.05",
+    "probe[1]={name=\"kinetic\",kind=\"energy\",part=\"kinetic\",of=\"fluid\"}",
+    "probe[2].x_max=0.03",
+];
+
+/// The fluid's total energy as the gate's second probe.
+const GATE_ENERGY: &str = "probe[1]={name=\"energy\",kind=\"energy\",part=\"total\",of=\"fluid\"}";
+
+/// The stress cases: the longer variants of `cosim/tests/stress.rs` (each must end `ok` with its energy within
+/// the budget, or be stopped `unstable` by a guard; `report.md` and `docs/PERFORMANCE.md` give the bounds).
+fn stress(scenes: &Path, quick: bool) -> Vec<Case> {
+    let mut cases = Vec::new();
+    let mut add =
+        |variant: &'static str, scene: &str, solver: &'static str, spacing: f64, end_time: f64, extra: &[&str]| {
+            cases.push(Case {
+                case: "stress",
+                variant,
+                scene: scenes.join(scene),
+                solver,
+                contact: "none",
+                spacing,
+                end_time,
+                threads: None,
+                repeats: 1,
+                extra: extra.iter().map(|s| s.to_string()).collect(),
+                metric: Metric::Stress,
+            });
+        };
+    let (still, tall, gate_end) = if quick {
+        ((10.0, 4.0), 0.01, 0.2)
+    } else {
+        ((30.0, 10.0), 0.005, 0.4)
+    };
+    add("still_tank", "dam_break.toml", "wcsph", 0.025, still.0, &STILL_TANK);
+    add("still_tank", "dam_break.toml", "isph", 0.025, still.1, &STILL_TANK);
+    for solver in ["wcsph", "isph"] {
+        add("tall_dam_break", "dam_break.toml", solver, tall, 2.0, &TALL_DAM_BREAK);
+        let mut cfl = TALL_DAM_BREAK.to_vec();
+        cfl.extend(["fluid.cfl=0.9", "coupling.max_dt=0.05"]);
+        add("tall_dam_break_cfl0.9", "dam_break.toml", solver, tall, 1.0, &cfl);
+    }
+    for solver in ["wcsph", "isph"] {
+        add(
+            "gate_stiff",
+            "elastic_gate.toml",
+            solver,
+            0.004,
+            gate_end,
+            &[
+                GATE_ENERGY,
+                "solid[0].material.youngs_modulus=1.2e8",
+                "coupling.fem_cfl=0.9",
+            ],
+        );
+        add(
+            "gate_soft",
+            "elastic_gate.toml",
+            solver,
+            0.004,
+            gate_end,
+            &[GATE_ENERGY, "solid[0].material.youngs_modulus=1.2e6"],
+        );
+    }
+    add(
+        "gate_large_dt",
+        "elastic_gate.toml",
+        "isph",
+        0.004,
+        gate_end,
+        &[GATE_ENERGY, "coupling.max_dt=1e-2"],
+    );
+    // The coupled scenes run with their own contact algorithm.
+    for c in &mut cases {
+        if c.scene.ends_with("elastic_gate.toml") {
+            c.contact = "particle_element";
+        }
+    }
+    cases
 }
