@@ -68,6 +68,12 @@ pub trait NodeCore {
         Vec::new()
     }
 
+    /// Energies for the live status, name → J per unit thickness (the structure's kinetic, strain and potential,
+    /// the fluid's kinetic and potential). Asked for at most a few times a second.
+    fn energy(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
+
     /// The node's whole state between two steps, for a checkpoint (`docs/PROTOCOL.md` §9); `None` for a node
     /// that cannot save one.
     fn checkpoint(&self) -> Option<Vec<u8>> {
@@ -82,6 +88,9 @@ pub trait NodeCore {
         })
     }
 }
+
+/// How often the live status's energies are recomputed (they cost a pass over the particles or elements).
+const ENERGY_EVERY: Duration = Duration::from_millis(500);
 
 fn zerr(e: zenoh::Error) -> anyhow::Error {
     anyhow::anyhow!("{e}")
@@ -198,6 +207,7 @@ fn serve_session<C: NodeCore>(
         .map_err(zerr)?;
 
     let mut idle_since = std::time::Instant::now();
+    let mut energy_at = idle_since - ENERGY_EVERY;
     loop {
         while let Ok(Some(query)) = checkpoints.try_recv() {
             // Between two steps: the state after step `expected - 1`, before the corrections of the next.
@@ -251,6 +261,19 @@ fn serve_session<C: NodeCore>(
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
+        if energy_at.elapsed() >= ENERGY_EVERY {
+            let energy: serde_json::Map<String, serde_json::Value> = core
+                .energy()
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v.into()))
+                .collect();
+            if !energy.is_empty() {
+                board.update(|s| {
+                    s.extra.insert("energy".into(), energy.into());
+                });
+            }
+            energy_at = std::time::Instant::now();
+        }
         idle_since = std::time::Instant::now();
         state_pub
             .put(Envelope::new(run, env.step, t, state).encode())

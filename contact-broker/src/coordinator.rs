@@ -19,7 +19,7 @@ use crate::probes::Probes;
 use crate::summary::{ContactStats, Summary, Timings};
 
 /// Progress of a run, reported after each coupling step.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Progress {
     /// Coupling steps taken.
     pub step: u64,
@@ -27,6 +27,12 @@ pub struct Progress {
     pub t: f64,
     /// End time [s].
     pub end_time: f64,
+    /// Contacts the last contact pass resolved.
+    pub contacts: u64,
+    /// Deepest penetration of the contact thickness so far [m].
+    pub max_penetration: f64,
+    /// Fluid particles exchanged in the last step (the region of interest).
+    pub exchanged: u64,
 }
 
 /// How the run is launched, for the summary.
@@ -219,6 +225,7 @@ fn drive(
     let mut pending = Corrections::default();
     let mut load = None;
     let mut exchanged = 0u64;
+    let mut last_pass = PassStats::default();
 
     let mut t = 0.0;
     let mut step = 0u64;
@@ -296,6 +303,7 @@ fn drive(
                 .pass(fem, sph, dt)
                 .with_context(|| format!("contact pass of coupling step {step} at t = {t} s"))?;
             pending = corrections;
+            last_pass = stats.clone();
             roi = Some(interface.roi(&fem.x));
             exchanged += stats.exchanged as u64;
             record(&mut summary.contact_stats, &stats, exchanged, step);
@@ -310,7 +318,14 @@ fn drive(
                 next_output += 1;
             }
         }
-        progress(Progress { step, t, end_time: end });
+        progress(Progress {
+            step,
+            t,
+            end_time: end,
+            contacts: last_pass.contacts as u64,
+            max_penetration: summary.contact_stats.max_penetration,
+            exchanged: last_pass.exchanged as u64,
+        });
         // Between two steps: every node answered `step`, its corrections are still to be sent.
         if let Some(interval) = plan.interval {
             if t >= next_checkpoint as f64 * interval - LANDING * cap {

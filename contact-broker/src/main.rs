@@ -173,6 +173,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         s.health = "running".into();
     });
+    let fem_and_fluid = fem.is_some() && sph.is_some();
     let nodes = Nodes {
         fem: fem.as_mut().map(|l| l as &mut FemLink),
         sph: sph.as_mut().map(|l| l as &mut SphLink),
@@ -195,6 +196,11 @@ fn run(args: Args) -> anyhow::Result<()> {
                 s.dt = dt;
                 s.extra.insert("wall_per_step".into(), wall.into());
                 s.extra.insert("progress".into(), (p.t / p.end_time).into());
+                if fem_and_fluid {
+                    s.extra.insert("contacts".into(), p.contacts.into());
+                    s.extra.insert("max_penetration".into(), p.max_penetration.into());
+                    s.extra.insert("exchanged".into(), p.exchanged.into());
+                }
             });
             (last_t, last_step, last_wall) = (p.t, p.step, Instant::now());
         }

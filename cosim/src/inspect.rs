@@ -62,6 +62,21 @@ fn table(doc: &serde_json::Value) -> String {
                 1e3 * number(s, "waiting_per_step"),
                 counts.join(", ")
             );
+            if let Some(energy) = s["extra"].get("energy").and_then(|e| e.as_object()) {
+                let parts: Vec<String> = energy
+                    .iter()
+                    .map(|(k, v)| format!("{k} {:.4e}", v.as_f64().unwrap_or(f64::NAN)))
+                    .collect();
+                out += &format!("{:<15} energy [J/m]: {}\n", "", parts.join(", "));
+            }
+            if let (Some(c), Some(p)) = (s["extra"].get("contacts"), s["extra"].get("max_penetration")) {
+                out += &format!(
+                    "{:<15} contacts {c}, max penetration {:.3e} m, particles exchanged {}\n",
+                    "",
+                    p.as_f64().unwrap_or(f64::NAN),
+                    s["extra"].get("exchanged").unwrap_or(&serde_json::Value::Null)
+                );
+            }
             if let Some(stats) = s["extra"].get("contact_stats") {
                 out += &format!("{:<15} contact_stats {stats}\n", "");
             }

@@ -116,6 +116,7 @@ fn parse_event(line: &str) -> Option<Event> {
             step: v.get("step")?.as_u64()?,
             t: v.get("t")?.as_f64()?,
             end_time: v.get("end_time")?.as_f64()?,
+            ..Progress::default()
         })),
         _ => None,
     }

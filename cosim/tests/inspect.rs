@@ -67,11 +67,22 @@ fn check_document(doc: &serde_json::Value, id: &str) {
     assert_eq!(nodes["fem-node"]["counts"]["nodes"], 480);
     assert_eq!(nodes["fem-node"]["counts"]["elements"], 395);
     assert_eq!(nodes["contact-broker"]["counts"]["particles"], 875);
-    // The nodes split their wall time into compute and waiting.
+    // The nodes split their wall time into compute and waiting, and report their energies.
     for name in ["fem-node", "sph-node"] {
         assert!(nodes[name]["compute_per_step"].as_f64().unwrap() > 0.0);
         assert!(nodes[name]["waiting_per_step"].as_f64().unwrap() >= 0.0);
+        let energy = &nodes[name]["extra"]["energy"];
+        assert!(energy["kinetic"].as_f64().unwrap() >= 0.0, "{name}: {energy}");
+        assert!(energy["potential"].as_f64().unwrap().is_finite(), "{name}: {energy}");
     }
+    // The water column stands on the floor: its potential energy, Σ m g y, is positive; the gate is strained.
+    assert!(nodes["sph-node"]["extra"]["energy"]["potential"].as_f64().unwrap() > 0.0);
+    assert!(nodes["fem-node"]["extra"]["energy"]["strain"].as_f64().unwrap() >= 0.0);
+    // The broker: the last pass's contacts, the deepest penetration so far, the particles exchanged.
+    let extra = &nodes["contact-broker"]["extra"];
+    assert!(extra["contacts"].as_u64().is_some(), "{extra}");
+    assert!(extra["max_penetration"].as_f64().unwrap() >= 0.0, "{extra}");
+    assert!(extra["exchanged"].as_u64().unwrap() > 0, "{extra}");
 }
 
 #[test]

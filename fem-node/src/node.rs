@@ -36,6 +36,16 @@ impl NodeCore for FemCore {
         ]
     }
 
+    fn energy(&self) -> Vec<(&'static str, f64)> {
+        let e = self.solver().energies();
+        let sum = |f: fn(&cosim_proto::messages::Energies) -> f64| e.iter().map(f).sum::<f64>();
+        vec![
+            ("kinetic", sum(|e| e.kinetic)),
+            ("strain", sum(|e| e.strain)),
+            ("potential", sum(|e| e.potential)),
+        ]
+    }
+
     fn checkpoint(&self) -> Option<Vec<u8>> {
         Some(FemCore::checkpoint(self))
     }

@@ -35,6 +35,14 @@ impl NodeCore for SphCore {
         ]
     }
 
+    fn energy(&self) -> Vec<(&'static str, f64)> {
+        let state = self.solver().state();
+        vec![
+            ("kinetic", state.kinetic_energy()),
+            ("potential", state.potential_energy(self.solver().params().gravity)),
+        ]
+    }
+
     fn checkpoint(&self) -> Option<Vec<u8>> {
         Some(SphCore::checkpoint(self))
     }
