@@ -11,6 +11,9 @@
 //! `SPH_BENCH_SOLVER=isph` measures the ISPH solver on the same scene instead (steps default 3, repetitions 3: a
 //! step solves a PPE; the neighbour and heap columns are not counted for ISPH and print 0; the PPE iterations of
 //! the last step are printed after the row).
+//! `SPH_BENCH_SET` (scene overrides separated by `;`, e.g. `fluid.kinematic_viscosity=1e-6;fluid.xsph=0`) measures a
+//! variant of the scene: what a switched-off term saves (the laminar viscosity loop is skipped at ν = 0, XSPH at
+//! ε = 0, the density filter at `none`).
 //! `SPH_BENCH_FINGERPRINT=1` instead prints a hash of the state after short runs of a few configurations (default
 //! dam break, MLS + APD, inviscid, a drop without walls), for checking that an optimisation leaves the results
 //! bit-identical.
@@ -127,7 +130,9 @@ fn run_size(spacing: f64) {
     let steps = env_usize("SPH_BENCH_STEPS", 20);
     let reps = env_usize("SPH_BENCH_REPS", 5);
     let before = peak_rss();
-    let mut solver = WcsphSolver::new(&scene(spacing, &[])).unwrap();
+    let set = std::env::var("SPH_BENCH_SET").unwrap_or_default();
+    let extra: Vec<&str> = set.split(';').filter(|s| !s.trim().is_empty()).collect();
+    let mut solver = WcsphSolver::new(&scene(spacing, &extra)).unwrap();
     let n = solver.state().len();
     let walls = solver.walls().len();
     for _ in 0..2 {
