@@ -272,6 +272,8 @@ fn serve_session<C: NodeCore>(
                     s.extra.insert("energy".into(), energy.into());
                 });
             }
+            // Counts that change during the run (the fluid's wall guard) are refreshed with the energies.
+            board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
             energy_at = std::time::Instant::now();
         }
         idle_since = std::time::Instant::now();

@@ -17,8 +17,8 @@ use crate::solver::{SphParams, WcsphSolver};
 use crate::stability::EnergyGuard;
 
 /// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9). Version 2: the
-/// solvers carry `fluid.cfl`.
-const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 2);
+/// solvers carry `fluid.cfl`; 3: the WCSPH solver carries its wall boxes and wall-guard count.
+const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 3);
 
 /// The fluid solver the scene asks for.
 #[derive(Serialize, Deserialize)]
@@ -85,6 +85,15 @@ impl Fluid {
         match self {
             Fluid::Wcsph(s) => s.stable_dt(),
             Fluid::Isph(s) => s.stable_dt(),
+        }
+    }
+
+    /// Fluid particles the WCSPH wall guard has put back out of a wall over the run
+    /// ([`WcsphSolver::wall_pushes`]); `None` for ISPH (its guard's count is per step, in its PPE report).
+    pub fn wall_pushes(&self) -> Option<u64> {
+        match self {
+            Fluid::Wcsph(s) => Some(s.wall_pushes().0),
+            Fluid::Isph(_) => None,
         }
     }
 

@@ -29,10 +29,13 @@ impl NodeCore for SphCore {
 
     fn counts(&self) -> Vec<(&'static str, u64)> {
         let s = SphCore::setup(self);
-        vec![
+        let mut counts = vec![
             ("particles", u64::from(s.particles)),
             ("wall_particles", s.walls.len() as u64),
-        ]
+        ];
+        // The WCSPH wall guard's interventions so far (refreshed with the energies).
+        counts.extend(self.solver().wall_pushes().map(|n| ("wall_pushes", n)));
+        counts
     }
 
     fn energy(&self) -> Vec<(&'static str, f64)> {
