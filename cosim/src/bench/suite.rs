@@ -327,6 +327,8 @@ fn stress(scenes: &Path, quick: bool) -> Vec<Case> {
             &[GATE_ENERGY, "solid[0].material.youngs_modulus=1.2e6"],
         );
     }
+    // The coarse WCSPH gate: a particle once fell through the floor near x = 0.3 m after t ≈ 0.35 s.
+    add("gate_coarse", "elastic_gate.toml", "wcsph", 0.005, 0.45, &[GATE_ENERGY]);
     add(
         "gate_large_dt",
         "elastic_gate.toml",
