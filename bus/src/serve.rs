@@ -208,6 +208,8 @@ fn serve_session<C: NodeCore>(
 
     let mut idle_since = std::time::Instant::now();
     let mut energy_at = idle_since - ENERGY_EVERY;
+    // The last command answered and its answer, to answer it again if it comes again.
+    let mut last: Option<(Vec<u8>, Vec<u8>)> = None;
     loop {
         while let Ok(Some(query)) = checkpoints.try_recv() {
             // Between two steps: the state after step `expected - 1`, before the corrections of the next.
@@ -234,7 +236,17 @@ fn serve_session<C: NodeCore>(
             }
             continue;
         };
-        let env = match Envelope::<StepCommand>::decode(&sample.payload().to_bytes(), run, topics.command)
+        let bytes = sample.payload().to_bytes();
+        // The command just answered, again: the broker sends a command again when its answer does not come
+        // (`docs/PROTOCOL.md` §8), so the answer may have been lost: send the same answer again, compute nothing.
+        if let Some((command, state)) = &last {
+            if command[..] == bytes[..] {
+                tracing::warn!("the command for step {} came again: answering it again", expected - 1);
+                state_pub.put(state.clone()).wait().map_err(zerr)?;
+                continue;
+            }
+        }
+        let env = match Envelope::<StepCommand>::decode(&bytes, run, topics.command)
             .and_then(|e| e.expect_step(expected, topics.command))
         {
             Ok(env) => env,
@@ -277,10 +289,9 @@ fn serve_session<C: NodeCore>(
             energy_at = std::time::Instant::now();
         }
         idle_since = std::time::Instant::now();
-        state_pub
-            .put(Envelope::new(run, env.step, t, state).encode())
-            .wait()
-            .map_err(zerr)?;
+        let answer = Envelope::new(run, env.step, t, state).encode();
+        state_pub.put(answer.clone()).wait().map_err(zerr)?;
+        last = Some((bytes.into_owned(), answer));
     }
 }
 

@@ -103,6 +103,8 @@ pub struct ZenohLink<S, T> {
     error: Sub,
     alive: Sub,
     step_timeout: Duration,
+    /// The last command sent (its step and bytes), to send again when its answer does not come.
+    last_command: Option<(u64, Vec<u8>)>,
     _state: std::marker::PhantomData<T>,
 }
 
@@ -184,6 +186,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             error: subs.error,
             alive: subs.alive,
             step_timeout,
+            last_command: None,
             _state: std::marker::PhantomData,
         })
     }
@@ -228,9 +231,11 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
     fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
         let bytes = Envelope::new(&self.run, step, t, cmd).encode();
         self.command
-            .put(bytes)
+            .put(bytes.clone())
             .wait()
-            .map_err(|e| self.failed(format!("cannot send step {step}: {e}")))
+            .map_err(|e| self.failed(format!("cannot send step {step}: {e}")))?;
+        self.last_command = Some((step, bytes));
+        Ok(())
     }
 
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
@@ -260,7 +265,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
     }
 
     fn receive(&mut self, step: u64) -> Result<T, LinkError> {
-        let deadline = Instant::now() + self.step_timeout;
+        let started = Instant::now();
+        let deadline = started + self.step_timeout;
+        // Without an answer after a third of the step timeout the command goes again (a node answers a command it
+        // already answered with the same answer, `docs/PROTOCOL.md` §8), so that a message lost on the way does
+        // not fail the run.
+        let resend_every = self.step_timeout / 3;
+        let mut resend_at = started + resend_every;
         // A message that is not this run's answer to this step (malformed, another version, run or step) is
         // refused: logged, never applied, and the wait goes on (`docs/PROTOCOL.md` §7).
         let mut refused: Option<String> = None;
@@ -282,6 +293,19 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                 Err(e) => return Err(self.failed(format!("state channel closed: {e}"))),
             }
             self.check_node()?;
+            if Instant::now() > resend_at && Instant::now() < deadline {
+                resend_at += resend_every;
+                if let Some((_, bytes)) = self.last_command.as_ref().filter(|(s, _)| *s == step) {
+                    tracing::warn!(
+                        "{}: no answer to step {step} after {:.0} s: sending the command again",
+                        self.topics.name,
+                        started.elapsed().as_secs_f64()
+                    );
+                    if let Err(e) = self.command.put(bytes.clone()).wait() {
+                        tracing::warn!("{}: cannot send step {step} again: {e}", self.topics.name);
+                    }
+                }
+            }
             if Instant::now() > deadline {
                 let why = refused.map(|r| format!("; refused instead: {r}")).unwrap_or_default();
                 return Err(self.failed(format!(

@@ -276,6 +276,7 @@ def main():
     session.put(f"{base}/fem/mesh", plate.mesh(args.run), congestion_control=zenoh.CongestionControl.BLOCK)
 
     expected, steps, started = 0, 0, time.monotonic()
+    last = None  # (command bytes, answer bytes): a command that comes again is answered again (PROTOCOL.md §8)
     while True:
         try:
             kind, payload = inbox.get(timeout=args.timeout)
@@ -284,6 +285,9 @@ def main():
         if kind == "broker":
             if payload == zenoh.SampleKind.DELETE:
                 fail("the broker is gone (broker/alive disappeared)")
+            continue
+        if last is not None and payload == last[0]:
+            pub_state.put(last[1])  # the broker sent it again: our answer was lost; compute nothing
             continue
         clock = time.perf_counter()
         try:
@@ -296,7 +300,9 @@ def main():
         if cmd["stop"]:
             break
         substeps = plate.advance(cmd["dt"]) if cmd["dt"] > 0 else 0
-        pub_state.put(plate.state(args.run, cmd, substeps, time.perf_counter() - clock))
+        answer = plate.state(args.run, cmd, substeps, time.perf_counter() - clock)
+        pub_state.put(answer)
+        last = (payload, answer)
         expected += 1
         steps += 1
     wall = time.monotonic() - started
