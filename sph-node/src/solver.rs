@@ -2,15 +2,17 @@
 //! or first-order MLS density filter, XSPH and APD (§4.4), advanced by kick–drift–kick.
 //!
 //! The solver owns the serializable [`FluidState`] and [`WallParticles`], a working copy of the particles sorted by
-//! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the kernel values of each pair,
+//! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the ∇W factor of each pair,
 //! rates).
 //!
 //! Speed (`docs/PERFORMANCE.md`): the fluid is re-sorted by cell at every neighbour search, so that the gathers read
 //! neighbouring memory; the neighbour lists are built once per search (fluid particles only: walls get their
-//! pressure straight from the cell bins) with W, ∇W and r² of every pair, and reused by every pass until the next
-//! search. Every sum still runs over the same neighbours in the same order, with the same arithmetic, as the
-//! plain gathers of [`continuity`], [`momentum`], [`adami`] and [`crate::corrections::xsph`] on the id-ordered
-//! particles, so the results are bit-identical to theirs (tests below) and independent of the thread count.
+//! pressure straight from the cell bins) with the ∇W factor of every pair, and reused by every pass until the next
+//! search (r² and W, where a pass needs them, are recomputed from the positions, which the lists were built from:
+//! 12 bytes per pair instead of 28). Every sum still runs over the same neighbours in the same order, with the
+//! same arithmetic, as the plain gathers of [`continuity`], [`momentum`], [`adami`] and
+//! [`crate::corrections::xsph`] on the id-ordered particles, so the results are bit-identical to theirs (tests
+//! below) and independent of the thread count.
 
 use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
@@ -23,7 +25,7 @@ use crate::error::{Result, SphError};
 use crate::integrator;
 use crate::kernel::CubicSpline;
 use crate::neighbors::{NeighborList, SortedCells, CHUNK};
-use crate::particles::{FluidState, ParticleView, WallParticles};
+use crate::particles::{separation, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::time_step;
 use crate::wcsph::{continuity, momentum, MomentumParams};
@@ -93,7 +95,7 @@ struct Sorted {
 struct Scratch {
     /// Boxed to keep the solver about as large as the ISPH one (`core::Fluid` holds either).
     cells: Box<SortedCells>,
-    /// Fluid neighbour lists (slots) with kernel factors.
+    /// Fluid neighbour lists (slots) with ∇W factors.
     list: NeighborList,
     /// Old slot of each new slot (re-sorting).
     src: Vec<u32>,
@@ -463,7 +465,13 @@ impl WcsphSolver {
         let mut corr = std::mem::take(&mut self.scratch.xsph);
         corr.clear();
         if self.params.xsph > 0.0 {
-            xsph_pairs_into(&self.view(), &self.scratch.list, self.params.xsph, &mut corr);
+            xsph_pairs_into(
+                &self.view(),
+                &self.scratch.list,
+                &self.kernel,
+                self.params.xsph,
+                &mut corr,
+            );
         }
         let s = &mut self.sorted;
         if !self.scratch.edited_x.is_empty() {
@@ -699,9 +707,15 @@ impl WcsphSolver {
     }
 }
 
-/// [`crate::corrections::xsph::xsph_correction`] of every fluid particle into `out`, with W of each pair taken from the lists: the
-/// same sum, bit for bit (checked by the tests below).
-fn xsph_pairs_into(view: &ParticleView<'_>, list: &NeighborList, eps: f64, out: &mut Vec<[f64; 2]>) {
+/// [`crate::corrections::xsph::xsph_correction`] of every fluid particle into `out`, over the neighbours of the
+/// lists: the same sum, bit for bit (checked by the tests below).
+fn xsph_pairs_into(
+    view: &ParticleView<'_>,
+    list: &NeighborList,
+    kernel: &CubicSpline,
+    eps: f64,
+    out: &mut Vec<[f64; 2]>,
+) {
     let nf = view.n_fluid;
     out.resize(nf, [0.0; 2]); // every entry is overwritten
     out.par_chunks_mut(CHUNK)
@@ -712,11 +726,15 @@ fn xsph_pairs_into(view: &ParticleView<'_>, list: &NeighborList, eps: f64, out: 
                 let (vi, rho_i) = (view.v[i], view.rho[i]);
                 let r = chunk.range(k);
                 let mut s = [0.0, 0.0];
-                for (&j, &w) in chunk.idx[r.clone()].iter().zip(&chunk.w()[r]) {
+                let xi = view.x[i];
+                for &j in &chunk.idx[r] {
                     let j = j as usize;
                     if j >= nf {
                         continue;
                     }
+                    // W(r) with r as `separation` computes it.
+                    let (_, r) = separation(xi, view.x[j]);
+                    let w = kernel.w(r);
                     // §4.4 XSPH
                     let f = view.m[j] / (0.5 * (rho_i + view.rho[j])) * w;
                     s[0] += f * (vi[0] - view.v[j][0]);
@@ -795,7 +813,7 @@ mod tests {
         a.iter().map(|a| a.map(f64::to_bits)).collect()
     }
 
-    /// The sorted lists with precomputed kernel values give, bit for bit, what the reference gathers give on the
+    /// The sorted lists with precomputed ∇W factors give, bit for bit, what the reference gathers give on the
     /// lists of a plain cell list over the same (sorted) particles: same neighbours in the same order, same
     /// continuity, momentum, wall pressure and XSPH.
     #[test]
@@ -833,7 +851,7 @@ mod tests {
             .collect();
         assert_eq!(bits(&accel), bits(&expected));
         let mut xsph = Vec::new();
-        xsph_pairs_into(&view, list, 0.5, &mut xsph);
+        xsph_pairs_into(&view, list, &kernel, 0.5, &mut xsph);
         let expected: Vec<_> = (0..nf)
             .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
             .collect();
