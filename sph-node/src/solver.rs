@@ -99,12 +99,11 @@ struct Scratch {
     list: NeighborList,
     /// Old slot of each new slot (re-sorting).
     src: Vec<u32>,
-    spare2: Vec<[f64; 2]>,
-    spare1: Vec<f64>,
-    drho: Vec<f64>,
-    filtered: Vec<f64>,
-    xsph: Vec<[f64; 2]>,
-    shift: Vec<[f64; 2]>,
+    /// One value per particle, for whichever pass needs it at the time (never two at once): the density rate,
+    /// the APD density change, the filtered density, the spare of the re-sort.
+    per1: Vec<f64>,
+    /// A vector per particle, likewise: the XSPH correction, the APD shift, the spare of the re-sort.
+    per2: Vec<[f64; 2]>,
     wall: Vec<(f64, f64)>,
     /// Positions (slot order) edited through `state_mut`, for the next drift; empty when none.
     edited_x: Vec<[f64; 2]>,
@@ -396,12 +395,8 @@ impl WcsphSolver {
             + sc.cells.heap_bytes()
             + sc.list.heap_bytes()
             + b(&sc.src)
-            + b(&sc.spare2)
-            + b(&sc.spare1)
-            + b(&sc.drho)
-            + b(&sc.filtered)
-            + b(&sc.xsph)
-            + b(&sc.shift)
+            + b(&sc.per1)
+            + b(&sc.per2)
             + b(&sc.wall)
             + b(&sc.edited_x)
     }
@@ -462,7 +457,7 @@ impl WcsphSolver {
         // A rate kept from the previous step (v^{n−½}) would make the acoustic modes grow.
         self.density_half_kick(dt);
         // Drift (XSPH at the old positions with the half-step velocities).
-        let mut corr = std::mem::take(&mut self.scratch.xsph);
+        let mut corr = std::mem::take(&mut self.scratch.per2);
         corr.clear();
         if self.params.xsph > 0.0 {
             xsph_pairs_into(
@@ -480,7 +475,7 @@ impl WcsphSolver {
             self.scratch.edited_x.clear();
         }
         integrator::drift(&mut s.x[..nf], &s.v[..nf], &corr, dt);
-        self.scratch.xsph = corr;
+        self.scratch.per2 = corr;
         self.check(step_no)?;
         self.rebuild_neighbors();
         // APD after the drift (§4.4; Xu et al. 2009, Eq. (35)), then the neighbours of the shifted positions.
@@ -492,17 +487,17 @@ impl WcsphSolver {
                     v_max,
                     dt,
                 };
-                let mut shift = std::mem::take(&mut self.scratch.shift);
+                let mut shift = std::mem::take(&mut self.scratch.per2);
                 apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &apd_params, &mut shift);
                 // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
-                let mut drho = std::mem::take(&mut self.scratch.filtered);
+                let mut drho = std::mem::take(&mut self.scratch.per1);
                 apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
                 let s = &mut self.sorted;
                 s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
                 update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-                self.scratch.filtered = drho;
+                self.scratch.per1 = drho;
                 integrator::drift(&mut s.x[..nf], &shift, &[], 1.0);
-                self.scratch.shift = shift;
+                self.scratch.per2 = shift;
                 self.check(step_no)?;
                 self.rebuild_neighbors();
             }
@@ -511,7 +506,7 @@ impl WcsphSolver {
         self.density_half_kick(dt);
         if let Some(n) = self.params.shepard_interval {
             if step_no % u64::from(n.max(1)) == 0 {
-                let mut filtered = std::mem::take(&mut self.scratch.filtered);
+                let mut filtered = std::mem::take(&mut self.scratch.per1);
                 if self.options.mls {
                     // §4.4 first-order MLS filter (Colagrossi & Landrini 2003, Eqs. (20)–(22))
                     mls::mls_into(&self.view(), &self.scratch.list, &self.kernel, &mut filtered);
@@ -522,7 +517,7 @@ impl WcsphSolver {
                 let s = &mut self.sorted;
                 s.rho[..nf].copy_from_slice(&filtered);
                 update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-                self.scratch.filtered = filtered;
+                self.scratch.per1 = filtered;
             }
         }
         if let Some(id) = self.first_bad(|s, k| !(s.rho[k].is_finite() && s.rho[k] > 0.0)) {
@@ -543,12 +538,12 @@ impl WcsphSolver {
     /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9)).
     fn density_half_kick(&mut self, dt: f64) {
         let nf = self.state.len();
-        let mut drho = std::mem::take(&mut self.scratch.drho);
+        let mut drho = std::mem::take(&mut self.scratch.per1);
         continuity::density_rates_pairs_into(&self.view(), &self.sorted.vol, &self.scratch.list, &mut drho);
         let s = &mut self.sorted;
         integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-        self.scratch.drho = drho;
+        self.scratch.per1 = drho;
     }
 
     /// EOS, wall pressures (Adami) and accelerations for the current positions, densities and velocities.
@@ -634,10 +629,10 @@ impl WcsphSolver {
         );
         let src = &sc.src;
         for a in [&mut s.x, &mut s.v, &mut s.accel] {
-            permute(a, &mut sc.spare2, src);
+            permute(a, &mut sc.per2, src);
         }
         for a in [&mut s.rho, &mut s.p, &mut s.m, &mut s.vol] {
-            permute(a, &mut sc.spare1, src);
+            permute(a, &mut sc.per1, src);
         }
         sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
     }
