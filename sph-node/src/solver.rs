@@ -93,8 +93,9 @@ struct Sorted {
 /// Scratch rebuilt every step: nothing here is state.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Scratch {
-    /// Boxed to keep the solver about as large as the ISPH one (`core::Fluid` holds either).
-    cells: Box<SortedCells>,
+    /// Cell bins (held inline: the solver is then about as large as the ISPH one, which `core::Fluid` may hold
+    /// instead).
+    cells: SortedCells,
     /// Fluid neighbour lists (slots) with ∇W factors.
     list: NeighborList,
     /// Old slot of each new slot (re-sorting).
@@ -257,7 +258,7 @@ impl WcsphSolver {
             accel: vec![[0.0; 2]; n],
         };
         let scratch = Scratch {
-            cells: Box::new(SortedCells::new(&walls.x)),
+            cells: SortedCells::new(&walls.x),
             ..Scratch::default()
         };
         let mut solver = Self {
