@@ -14,7 +14,7 @@ use cosim_proto::scene::{LoadedScene, SceneError};
 use crate::checkpoint::{self, BrokerState};
 use crate::interface::{Corrections, Interface, PassStats};
 use crate::link::{FemLink, LinkError, Reply, SphLink};
-use crate::output::{plot_probe, FrameQueue, FrameWriter, PointField, ProbeCsv};
+use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::Probes;
 use crate::summary::{ContactStats, Summary, Timings};
 
@@ -506,33 +506,17 @@ fn write_particles(
     density: f64,
     snap: &SphSnapshot,
 ) -> crate::output::Result<()> {
-    let x: Vec<[f64; 2]> = snap.x.iter().chain(wall_x).copied().collect();
-    let walls = wall_x.len();
-    let v: Vec<[f64; 2]> = snap
-        .v
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n([0.0; 2], walls))
-        .collect();
-    let p: Vec<f64> = snap.p.iter().chain(&snap.wall_p).copied().collect();
-    let rho: Vec<f64> = snap
-        .rho
-        .iter()
-        .copied()
-        .chain(std::iter::repeat_n(density, walls))
-        .collect();
-    let kind: Vec<f64> = std::iter::repeat_n(0.0, snap.x.len())
-        .chain(std::iter::repeat_n(1.0, walls))
-        .collect();
-    frames.write_particles(
+    // The frame is streamed from the snapshot and the walls as they are: no concatenated copy.
+    let (fluid, walls) = (snap.x.len(), wall_x.len());
+    frames.write_particle_parts(
         index,
         t,
-        &x,
+        &[Part::Slice(&snap.x), Part::Slice(wall_x)],
         &[
-            PointField::Vector("velocity", &v),
-            PointField::Scalar("pressure", &p),
-            PointField::Scalar("density", &rho),
-            PointField::Scalar("wall", &kind),
+            PointField::VectorParts("velocity", &[Part::Slice(&snap.v), Part::Repeat([0.0; 2], walls)]),
+            PointField::ScalarParts("pressure", &[Part::Slice(&snap.p), Part::Slice(&snap.wall_p)]),
+            PointField::ScalarParts("density", &[Part::Slice(&snap.rho), Part::Repeat(density, walls)]),
+            PointField::ScalarParts("wall", &[Part::Repeat(0.0, fluid), Part::Repeat(1.0, walls)]),
         ],
     )?;
     Ok(())

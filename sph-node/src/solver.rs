@@ -2,15 +2,17 @@
 //! or first-order MLS density filter, XSPH and APD (§4.4), advanced by kick–drift–kick.
 //!
 //! The solver owns the serializable [`FluidState`] and [`WallParticles`], a working copy of the particles sorted by
-//! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the kernel values of each pair,
+//! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the ∇W factor of each pair,
 //! rates).
 //!
 //! Speed (`docs/PERFORMANCE.md`): the fluid is re-sorted by cell at every neighbour search, so that the gathers read
 //! neighbouring memory; the neighbour lists are built once per search (fluid particles only: walls get their
-//! pressure straight from the cell bins) with W, ∇W and r² of every pair, and reused by every pass until the next
-//! search. Every sum still runs over the same neighbours in the same order, with the same arithmetic, as the
-//! plain gathers of [`continuity`], [`momentum`], [`adami`] and [`crate::corrections::xsph`] on the id-ordered
-//! particles, so the results are bit-identical to theirs (tests below) and independent of the thread count.
+//! pressure straight from the cell bins) with the ∇W factor of every pair, and reused by every pass until the next
+//! search (r² and W, where a pass needs them, are recomputed from the positions, which the lists were built from:
+//! 12 bytes per pair instead of 28). Every sum still runs over the same neighbours in the same order, with the
+//! same arithmetic, as the plain gathers of [`continuity`], [`momentum`], [`adami`] and
+//! [`crate::corrections::xsph`] on the id-ordered particles, so the results are bit-identical to theirs (tests
+//! below) and independent of the thread count.
 
 use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
@@ -24,7 +26,7 @@ use crate::integrator;
 use crate::isph::wall_guard::WallBoxes;
 use crate::kernel::CubicSpline;
 use crate::neighbors::{NeighborList, SortedCells, CHUNK};
-use crate::particles::{FluidState, ParticleView, WallParticles};
+use crate::particles::{separation, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::time_step;
 use crate::wcsph::{continuity, momentum, MomentumParams};
@@ -92,18 +94,18 @@ struct Sorted {
 /// Scratch rebuilt every step: nothing here is state.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Scratch {
-    /// Boxed to keep the solver about as large as the ISPH one (`core::Fluid` holds either).
-    cells: Box<SortedCells>,
-    /// Fluid neighbour lists (slots) with kernel factors.
+    /// Cell bins (held inline: the solver is then about as large as the ISPH one, which `core::Fluid` may hold
+    /// instead).
+    cells: SortedCells,
+    /// Fluid neighbour lists (slots) with ∇W factors.
     list: NeighborList,
     /// Old slot of each new slot (re-sorting).
     src: Vec<u32>,
-    spare2: Vec<[f64; 2]>,
-    spare1: Vec<f64>,
-    drho: Vec<f64>,
-    filtered: Vec<f64>,
-    xsph: Vec<[f64; 2]>,
-    shift: Vec<[f64; 2]>,
+    /// One value per particle, for whichever pass needs it at the time (never two at once): the density rate,
+    /// the APD density change, the filtered density, the spare of the re-sort.
+    per1: Vec<f64>,
+    /// A vector per particle, likewise: the XSPH correction, the APD shift, the spare of the re-sort.
+    per2: Vec<[f64; 2]>,
     wall: Vec<(f64, f64)>,
     /// Positions (slot order) edited through `state_mut`, for the next drift; empty when none.
     edited_x: Vec<[f64; 2]>,
@@ -263,7 +265,7 @@ impl WcsphSolver {
             accel: vec![[0.0; 2]; n],
         };
         let scratch = Scratch {
-            cells: Box::new(SortedCells::new(&walls.x)),
+            cells: SortedCells::new(&walls.x),
             ..Scratch::default()
         };
         let mut solver = Self {
@@ -420,12 +422,8 @@ impl WcsphSolver {
             + sc.cells.heap_bytes()
             + sc.list.heap_bytes()
             + b(&sc.src)
-            + b(&sc.spare2)
-            + b(&sc.spare1)
-            + b(&sc.drho)
-            + b(&sc.filtered)
-            + b(&sc.xsph)
-            + b(&sc.shift)
+            + b(&sc.per1)
+            + b(&sc.per2)
             + b(&sc.wall)
             + b(&sc.edited_x)
     }
@@ -486,10 +484,16 @@ impl WcsphSolver {
         // A rate kept from the previous step (v^{n−½}) would make the acoustic modes grow.
         self.density_half_kick(dt);
         // Drift (XSPH at the old positions with the half-step velocities).
-        let mut corr = std::mem::take(&mut self.scratch.xsph);
+        let mut corr = std::mem::take(&mut self.scratch.per2);
         corr.clear();
         if self.params.xsph > 0.0 {
-            xsph_pairs_into(&self.view(), &self.scratch.list, self.params.xsph, &mut corr);
+            xsph_pairs_into(
+                &self.view(),
+                &self.scratch.list,
+                &self.kernel,
+                self.params.xsph,
+                &mut corr,
+            );
         }
         let s = &mut self.sorted;
         if !self.scratch.edited_x.is_empty() {
@@ -498,7 +502,7 @@ impl WcsphSolver {
             self.scratch.edited_x.clear();
         }
         integrator::drift(&mut s.x[..nf], &s.v[..nf], &corr, dt);
-        self.scratch.xsph = corr;
+        self.scratch.per2 = corr;
         let mut pushes = self.push_out_of_walls();
         self.check(step_no)?;
         self.rebuild_neighbors();
@@ -511,17 +515,17 @@ impl WcsphSolver {
                     v_max,
                     dt,
                 };
-                let mut shift = std::mem::take(&mut self.scratch.shift);
+                let mut shift = std::mem::take(&mut self.scratch.per2);
                 apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &apd_params, &mut shift);
                 // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
-                let mut drho = std::mem::take(&mut self.scratch.filtered);
+                let mut drho = std::mem::take(&mut self.scratch.per1);
                 apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
                 let s = &mut self.sorted;
                 s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
                 update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-                self.scratch.filtered = drho;
+                self.scratch.per1 = drho;
                 integrator::drift(&mut s.x[..nf], &shift, &[], 1.0);
-                self.scratch.shift = shift;
+                self.scratch.per2 = shift;
                 pushes += self.push_out_of_walls();
                 self.check(step_no)?;
                 self.rebuild_neighbors();
@@ -531,7 +535,7 @@ impl WcsphSolver {
         self.density_half_kick(dt);
         if let Some(n) = self.params.shepard_interval {
             if step_no % u64::from(n.max(1)) == 0 {
-                let mut filtered = std::mem::take(&mut self.scratch.filtered);
+                let mut filtered = std::mem::take(&mut self.scratch.per1);
                 if self.options.mls {
                     // §4.4 first-order MLS filter (Colagrossi & Landrini 2003, Eqs. (20)–(22))
                     mls::mls_into(&self.view(), &self.scratch.list, &self.kernel, &mut filtered);
@@ -542,7 +546,7 @@ impl WcsphSolver {
                 let s = &mut self.sorted;
                 s.rho[..nf].copy_from_slice(&filtered);
                 update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-                self.scratch.filtered = filtered;
+                self.scratch.per1 = filtered;
             }
         }
         if let Some(id) = self.first_bad(|s, k| !(s.rho[k].is_finite() && s.rho[k] > 0.0)) {
@@ -578,12 +582,12 @@ impl WcsphSolver {
     /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9)).
     fn density_half_kick(&mut self, dt: f64) {
         let nf = self.state.len();
-        let mut drho = std::mem::take(&mut self.scratch.drho);
+        let mut drho = std::mem::take(&mut self.scratch.per1);
         continuity::density_rates_pairs_into(&self.view(), &self.sorted.vol, &self.scratch.list, &mut drho);
         let s = &mut self.sorted;
         integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-        self.scratch.drho = drho;
+        self.scratch.per1 = drho;
     }
 
     /// EOS, wall pressures (Adami) and accelerations for the current positions, densities and velocities.
@@ -669,10 +673,10 @@ impl WcsphSolver {
         );
         let src = &sc.src;
         for a in [&mut s.x, &mut s.v, &mut s.accel] {
-            permute(a, &mut sc.spare2, src);
+            permute(a, &mut sc.per2, src);
         }
         for a in [&mut s.rho, &mut s.p, &mut s.m, &mut s.vol] {
-            permute(a, &mut sc.spare1, src);
+            permute(a, &mut sc.per1, src);
         }
         sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
     }
@@ -742,9 +746,15 @@ impl WcsphSolver {
     }
 }
 
-/// [`crate::corrections::xsph::xsph_correction`] of every fluid particle into `out`, with W of each pair taken from the lists: the
-/// same sum, bit for bit (checked by the tests below).
-fn xsph_pairs_into(view: &ParticleView<'_>, list: &NeighborList, eps: f64, out: &mut Vec<[f64; 2]>) {
+/// [`crate::corrections::xsph::xsph_correction`] of every fluid particle into `out`, over the neighbours of the
+/// lists: the same sum, bit for bit (checked by the tests below).
+fn xsph_pairs_into(
+    view: &ParticleView<'_>,
+    list: &NeighborList,
+    kernel: &CubicSpline,
+    eps: f64,
+    out: &mut Vec<[f64; 2]>,
+) {
     let nf = view.n_fluid;
     out.resize(nf, [0.0; 2]); // every entry is overwritten
     out.par_chunks_mut(CHUNK)
@@ -755,11 +765,15 @@ fn xsph_pairs_into(view: &ParticleView<'_>, list: &NeighborList, eps: f64, out: 
                 let (vi, rho_i) = (view.v[i], view.rho[i]);
                 let r = chunk.range(k);
                 let mut s = [0.0, 0.0];
-                for (&j, &w) in chunk.idx[r.clone()].iter().zip(&chunk.w()[r]) {
+                let xi = view.x[i];
+                for &j in &chunk.idx[r] {
                     let j = j as usize;
                     if j >= nf {
                         continue;
                     }
+                    // W(r) with r as `separation` computes it.
+                    let (_, r) = separation(xi, view.x[j]);
+                    let w = kernel.w(r);
                     // §4.4 XSPH
                     let f = view.m[j] / (0.5 * (rho_i + view.rho[j])) * w;
                     s[0] += f * (vi[0] - view.v[j][0]);
@@ -838,7 +852,7 @@ mod tests {
         a.iter().map(|a| a.map(f64::to_bits)).collect()
     }
 
-    /// The sorted lists with precomputed kernel values give, bit for bit, what the reference gathers give on the
+    /// The sorted lists with precomputed ∇W factors give, bit for bit, what the reference gathers give on the
     /// lists of a plain cell list over the same (sorted) particles: same neighbours in the same order, same
     /// continuity, momentum, wall pressure and XSPH.
     #[test]
@@ -876,7 +890,7 @@ mod tests {
             .collect();
         assert_eq!(bits(&accel), bits(&expected));
         let mut xsph = Vec::new();
-        xsph_pairs_into(&view, list, 0.5, &mut xsph);
+        xsph_pairs_into(&view, list, &kernel, 0.5, &mut xsph);
         let expected: Vec<_> = (0..nf)
             .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
             .collect();

@@ -23,7 +23,7 @@ pub use csv::ProbeCsv;
 pub use plot::{plot_probe, read_reference};
 pub use pvd::PvdCollection;
 pub use queue::{FrameJob, FrameQueue};
-pub use vtk::{von_mises_2d, FrameWriter, PointField};
+pub use vtk::{von_mises_2d, FrameWriter, Part, PointField};
 
 /// An output file could not be written, or an input to it was unusable. Each variant names the file.
 #[derive(Debug, thiserror::Error)]

@@ -24,6 +24,42 @@ pub fn von_mises_2d(s: [f64; 3]) -> f64 {
     (xx * xx - xx * yy + yy * yy + 3.0 * xy * xy).sqrt()
 }
 
+/// A run of consecutive values of a per-particle column: the values of a slice, or one value repeated.
+#[derive(Clone, Copy, Debug)]
+pub enum Part<'a, T> {
+    /// These values.
+    Slice(&'a [T]),
+    /// This value, this many times.
+    Repeat(T, usize),
+}
+
+impl<T> Part<'_, T> {
+    /// Number of values.
+    pub fn len(&self) -> usize {
+        match self {
+            Part::Slice(v) => v.len(),
+            Part::Repeat(_, n) => *n,
+        }
+    }
+
+    /// True when the part holds no value.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The values of `parts`, one after the other, in a new vector.
+fn concat<T: Copy>(parts: &[Part<'_, T>]) -> Vec<T> {
+    let mut out = Vec::with_capacity(parts.iter().map(Part::len).sum());
+    for part in parts {
+        match *part {
+            Part::Slice(v) => out.extend_from_slice(v),
+            Part::Repeat(x, n) => out.extend(std::iter::repeat_n(x, n)),
+        }
+    }
+    out
+}
+
 /// A per-particle array for [`FrameWriter::write_particles`].
 #[derive(Clone, Copy, Debug)]
 pub enum PointField<'a> {
@@ -31,6 +67,42 @@ pub enum PointField<'a> {
     Scalar(&'a str, &'a [f64]),
     /// A 2D vector per point (written with z = 0).
     Vector(&'a str, &'a [[f64; 2]]),
+    /// One value per point, from consecutive parts (no concatenated copy is made).
+    ScalarParts(&'a str, &'a [Part<'a, f64>]),
+    /// A 2D vector per point (written with z = 0), from consecutive parts.
+    VectorParts(&'a str, &'a [Part<'a, [f64; 2]>]),
+}
+
+impl PointField<'_> {
+    /// The array's name.
+    pub fn name(&self) -> &str {
+        match self {
+            PointField::Scalar(name, _)
+            | PointField::Vector(name, _)
+            | PointField::ScalarParts(name, _)
+            | PointField::VectorParts(name, _) => name,
+        }
+    }
+
+    /// Number of values (points).
+    pub fn len(&self) -> usize {
+        match self {
+            PointField::Scalar(_, v) => v.len(),
+            PointField::Vector(_, v) => v.len(),
+            PointField::ScalarParts(_, parts) => parts.iter().map(Part::len).sum(),
+            PointField::VectorParts(_, parts) => parts.iter().map(Part::len).sum(),
+        }
+    }
+
+    /// True when the field holds no value.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// A vector field (else a scalar one).
+    pub fn is_vector(&self) -> bool {
+        matches!(self, PointField::Vector(..) | PointField::VectorParts(..))
+    }
 }
 
 /// Writes the frames of a run into `DIR/frames/` and keeps their `.pvd` collections current.
@@ -120,13 +192,56 @@ impl FrameWriter {
         x: &[[f64; 2]],
         fields: &[PointField<'_>],
     ) -> Result<PathBuf> {
+        self.write_particle_parts(index, t, &[Part::Slice(x)], fields)
+    }
+
+    /// [`FrameWriter::write_particles`] with the positions in consecutive parts (e.g. the fluid's, then the
+    /// walls'): the frame is streamed from the parts as they are, with no concatenated copy of any array.
+    pub fn write_particle_parts(
+        &mut self,
+        index: usize,
+        t: f64,
+        x: &[Part<'_, [f64; 2]>],
+        fields: &[PointField<'_>],
+    ) -> Result<PathBuf> {
         let name = format!("particles_{index:05}.vtu");
         let path = self.dir.join(&name);
-        let piece = particle_piece(&path, x, fields)?;
-        write_vtu(&path, piece)?;
+        let n = x.iter().map(Part::len).sum();
+        for field in fields {
+            let len = field.len();
+            if len != n {
+                return Err(OutputError::input(
+                    &path,
+                    format!("point field `{}` has {len} entries for {n} particles", field.name()),
+                ));
+            }
+        }
+        if super::vtu::particles_writable(n, fields) {
+            write_streamed(&path, |out| super::vtu::write_particles(out, n, x, fields))?;
+        } else {
+            let piece = particle_piece(&concat(x), fields);
+            write_vtu(&path, piece)?;
+        }
         self.particles.push(t, &name)?;
         Ok(path)
     }
+}
+
+/// Write a frame to a temporary file through `write` (streaming), then rename it.
+fn write_streamed(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    let file = std::fs::File::create(&tmp).map_err(|e| OutputError::io(&tmp, e))?;
+    let mut out = std::io::BufWriter::with_capacity(64 * 1024, file);
+    write(&mut out)
+        .and_then(|()| out.flush())
+        .map_err(|e| OutputError::io(&tmp, e))?;
+    drop(out);
+    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
 }
 
 /// Write the frame to a temporary file, streaming (the text of a frame is never held whole), then rename it.
@@ -135,17 +250,7 @@ fn write_vtu(path: &Path, piece: UnstructuredGridPiece) -> Result<()> {
         let bytes = vtkio_xml(path, piece)?;
         return write_atomic(path, &bytes);
     };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let file = std::fs::File::create(&tmp).map_err(|e| OutputError::io(&tmp, e))?;
-    let mut out = std::io::BufWriter::with_capacity(64 * 1024, file);
-    checked
-        .write(&mut out)
-        .and_then(|()| out.flush())
-        .map_err(|e| OutputError::io(&tmp, e))?;
-    drop(out);
-    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
+    write_streamed(path, |out| checked.write(out))
 }
 
 /// The `.vtu` file as vtkio writes it (the reference the direct writer is tested against, and its fallback).
@@ -276,26 +381,20 @@ fn structure_piece(
     })
 }
 
-fn particle_piece(path: &Path, x: &[[f64; 2]], fields: &[PointField<'_>]) -> Result<UnstructuredGridPiece> {
+/// The vtkio piece of a particle frame (the fallback of [`FrameWriter::write_particle_parts`], and the reference
+/// its streamed writer is tested against); the fields' lengths are checked by the caller.
+fn particle_piece(x: &[[f64; 2]], fields: &[PointField<'_>]) -> UnstructuredGridPiece {
     let n = x.len();
-    let mut point = Vec::with_capacity(fields.len());
-    for field in fields {
-        let (name, len) = match field {
-            PointField::Scalar(name, v) => (name, v.len()),
-            PointField::Vector(name, v) => (name, v.len()),
-        };
-        if len != n {
-            return Err(OutputError::input(
-                path,
-                format!("point field `{name}` has {len} entries for {n} particles"),
-            ));
-        }
-        point.push(match field {
+    let point = fields
+        .iter()
+        .map(|field| match *field {
             PointField::Scalar(name, v) => scalars(name, 1, v.to_vec()),
             PointField::Vector(name, v) => vectors(name, vec3(v)),
-        });
-    }
-    Ok(UnstructuredGridPiece {
+            PointField::ScalarParts(name, parts) => scalars(name, 1, concat(parts)),
+            PointField::VectorParts(name, parts) => vectors(name, vec3(&concat(parts))),
+        })
+        .collect();
+    UnstructuredGridPiece {
         points: vec3(x).into(),
         cells: Cells {
             cell_verts: VertexNumbers::XML {
@@ -308,7 +407,7 @@ fn particle_piece(path: &Path, x: &[[f64; 2]], fields: &[PointField<'_>]) -> Res
             point,
             cell: Vec::new(),
         },
-    })
+    }
 }
 
 #[cfg(test)]
@@ -388,9 +487,34 @@ mod tests {
                 PointField::Scalar("pressure", &p),
                 PointField::Scalar("wall", &kind),
             ];
-            pieces.push(particle_piece(path, &x, &fields).unwrap());
-            pieces.push(particle_piece(path, &x, &fields[1..]).unwrap());
-            pieces.push(particle_piece(path, &x, &[]).unwrap());
+            for fields in [&fields[..], &fields[1..], &[]] {
+                let piece = particle_piece(&x, fields);
+                // The streamed particle writer, from the whole arrays and from parts of them.
+                let mut streamed = Vec::new();
+                super::super::vtu::write_particles(&mut streamed, n, &[Part::Slice(&x)], fields).unwrap();
+                let reference = vtkio_xml(path, piece.clone()).unwrap();
+                assert_eq!(
+                    String::from_utf8(streamed).unwrap(),
+                    String::from_utf8(reference.clone()).unwrap()
+                );
+                let k = n / 3;
+                let xs = [Part::Slice(&x[..k]), Part::Slice(&x[k..])];
+                let vs = [Part::Slice(&v[..k]), Part::Slice(&v[k..])];
+                let ps = [Part::Repeat(p[0], 1), Part::Slice(&p[1..])];
+                let parts = [
+                    PointField::VectorParts("velocity", &vs),
+                    PointField::ScalarParts("pressure", &ps),
+                    PointField::Scalar("wall", &kind),
+                ];
+                let parts = &parts[3 - fields.len()..];
+                let mut streamed = Vec::new();
+                super::super::vtu::write_particles(&mut streamed, n, &xs, parts).unwrap();
+                assert_eq!(
+                    String::from_utf8(streamed).unwrap(),
+                    String::from_utf8(reference).unwrap()
+                );
+                pieces.push(piece);
+            }
         }
         for piece in pieces {
             let direct = super::super::vtu::to_xml(&piece).expect("a frame shape");
@@ -400,7 +524,8 @@ mod tests {
             );
         }
         // Empty frames are left to vtkio.
-        assert!(super::super::vtu::to_xml(&particle_piece(path, &[], &[]).unwrap()).is_none());
+        assert!(super::super::vtu::to_xml(&particle_piece(&[], &[])).is_none());
+        assert!(!super::super::vtu::particles_writable(0, &[]));
     }
 
     #[test]

@@ -7,7 +7,9 @@
 
 use std::io::{self, Write};
 
-use vtkio::model::{Attribute, ElementType, IOBuffer, UnstructuredGridPiece, VertexNumbers};
+use vtkio::model::{Attribute, CellType, ElementType, IOBuffer, UnstructuredGridPiece, VertexNumbers};
+
+use super::vtk::{Part, PointField};
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
@@ -127,6 +129,18 @@ fn values<W: Write>(enc: &mut Base64<'_, W>, buf: &IOBuffer) -> io::Result<()> {
 /// `<DataArray …>base64</DataArray>`; `name` is omitted for the points. The buffer's kind is checked first.
 fn array<W: Write>(out: &mut W, name: Option<&str>, components: u32, buf: &IOBuffer) -> io::Result<()> {
     let (ty, len) = kind(buf).expect("checked by `check`");
+    array_with(out, name, ty, components, len, |enc| values(enc, buf))
+}
+
+/// `<DataArray …>base64</DataArray>` of `len` bytes that `body` pushes into the encoder.
+fn array_with<W: Write>(
+    out: &mut W,
+    name: Option<&str>,
+    ty: &str,
+    components: u32,
+    len: usize,
+    body: impl FnOnce(&mut Base64<'_, W>) -> io::Result<()>,
+) -> io::Result<()> {
     write!(out, "<DataArray type=\"{ty}\"")?;
     if let Some(name) = name {
         write!(out, " Name=\"{name}\"")?;
@@ -135,9 +149,142 @@ fn array<W: Write>(out: &mut W, name: Option<&str>, components: u32, buf: &IOBuf
     let mut enc = Base64::new(out);
     // vtkio's binary block: a UInt64 byte count, then the values.
     enc.push(&(len as u64).to_le_bytes())?;
-    values(&mut enc, buf)?;
+    body(&mut enc)?;
     enc.finish()?;
     out.write_all(b"</DataArray>")
+}
+
+/// Values into the encoder a few thousand bytes at a time.
+struct Blocks<'e, 'w, W: Write> {
+    enc: &'e mut Base64<'w, W>,
+    block: Vec<u8>,
+}
+
+impl<'e, 'w, W: Write> Blocks<'e, 'w, W> {
+    const BYTES: usize = 8 * 1024;
+
+    fn new(enc: &'e mut Base64<'w, W>) -> Self {
+        Self {
+            enc,
+            block: Vec::with_capacity(Self::BYTES + 24),
+        }
+    }
+
+    #[inline]
+    fn put(&mut self, bytes: &[u8]) -> io::Result<()> {
+        self.block.extend_from_slice(bytes);
+        if self.block.len() >= Self::BYTES {
+            self.enc.push(&self.block)?;
+            self.block.clear();
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> io::Result<()> {
+        self.enc.push(&self.block)
+    }
+}
+
+/// The little-endian bytes of every value of `parts`, `le` writing one value.
+fn parts_values<W: Write, T: Copy>(
+    enc: &mut Base64<'_, W>,
+    parts: &[Part<'_, T>],
+    le: impl Fn(T, &mut Blocks<'_, '_, W>) -> io::Result<()>,
+) -> io::Result<()> {
+    let mut blocks = Blocks::new(enc);
+    for part in parts {
+        match *part {
+            Part::Slice(v) => v.iter().try_for_each(|&x| le(x, &mut blocks))?,
+            Part::Repeat(x, n) => (0..n).try_for_each(|_| le(x, &mut blocks))?,
+        }
+    }
+    blocks.finish()
+}
+
+/// A 2D vector as a VTK 3-vector (z = 0).
+fn vec3_le<W: Write>(p: [f64; 2], b: &mut Blocks<'_, '_, W>) -> io::Result<()> {
+    b.put(&p[0].to_le_bytes())?;
+    b.put(&p[1].to_le_bytes())?;
+    b.put(&0f64.to_le_bytes())
+}
+
+/// Whether [`write_particles`] writes a frame of `n` points with `columns` as vtkio would (names it can write
+/// as they are, at least one point); else the caller builds the piece and falls back to vtkio.
+pub(crate) fn particles_writable(n: usize, columns: &[PointField<'_>]) -> bool {
+    n > 0
+        && columns.iter().all(|c| {
+            let name = c.name();
+            !name.is_empty() && name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')
+        })
+}
+
+/// The `.vtu` file of `n` particles at `x` (one `VTK_VERTEX` cell each, z = 0) with `columns` as point data,
+/// streamed from the parts as they are: byte for byte what [`Checked::write`] writes for the piece
+/// `super::vtk` builds of the same values (the tests compare the two), without that piece or its copies.
+/// Every part list must hold `n` values and [`particles_writable`] must hold.
+pub(crate) fn write_particles<W: Write>(
+    out: &mut W,
+    n: usize,
+    x: &[Part<'_, [f64; 2]>],
+    columns: &[PointField<'_>],
+) -> io::Result<()> {
+    out.write_all(
+        b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
+          <UnstructuredGrid>",
+    )?;
+    write!(
+        out,
+        "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" \
+         NumberOfPolys=\"0\" NumberOfVerts=\"0\">"
+    )?;
+    if columns.is_empty() {
+        out.write_all(b"<PointData/>")?;
+    } else {
+        out.write_all(b"<PointData")?;
+        // vtkio marks the first scalar and the first vector array as the active ones.
+        if let Some(c) = columns.iter().find(|c| !c.is_vector()) {
+            write!(out, " Scalars=\"{}\"", c.name())?;
+        }
+        if let Some(c) = columns.iter().find(|c| c.is_vector()) {
+            write!(out, " Vectors=\"{}\"", c.name())?;
+        }
+        out.write_all(b">")?;
+        let scalar = |v: f64, b: &mut Blocks<'_, '_, W>| b.put(&v.to_le_bytes());
+        for c in columns {
+            let name = Some(c.name());
+            match *c {
+                PointField::Scalar(_, v) => array_with(out, name, "Float64", 1, 8 * n, |enc| {
+                    parts_values(enc, &[Part::Slice(v)], scalar)
+                })?,
+                PointField::ScalarParts(_, parts) => {
+                    array_with(out, name, "Float64", 1, 8 * n, |enc| parts_values(enc, parts, scalar))?
+                }
+                PointField::Vector(_, v) => array_with(out, name, "Float64", 3, 24 * n, |enc| {
+                    parts_values(enc, &[Part::Slice(v)], vec3_le)
+                })?,
+                PointField::VectorParts(_, parts) => {
+                    array_with(out, name, "Float64", 3, 24 * n, |enc| parts_values(enc, parts, vec3_le))?
+                }
+            }
+        }
+        out.write_all(b"</PointData>")?;
+    }
+    out.write_all(b"<CellData/><Points>")?;
+    array_with(out, None, "Float64", 3, 24 * n, |enc| parts_values(enc, x, vec3_le))?;
+    out.write_all(b"</Points><Cells>")?;
+    let counting = |first: u64| {
+        move |enc: &mut Base64<'_, W>| {
+            let mut blocks = Blocks::new(enc);
+            (first..first + n as u64).try_for_each(|k| blocks.put(&k.to_le_bytes()))?;
+            blocks.finish()
+        }
+    };
+    array_with(out, Some("connectivity"), "UInt64", 1, 8 * n, counting(0))?;
+    array_with(out, Some("offsets"), "UInt64", 1, 8 * n, counting(1))?;
+    array_with(out, Some("types"), "UInt8", 1, n, |enc| {
+        parts_values(enc, &[Part::Repeat(CellType::Vertex as u8, n)], |t, b| b.put(&[t]))
+    })?;
+    out.write_all(b"</Cells></Piece></UnstructuredGrid></VTKFile>")
 }
 
 /// The arrays of a `<PointData>` or `<CellData>`: (name, components, data), and the active scalar and vector

@@ -81,40 +81,27 @@ impl CubicSpline {
         (w, factor)
     }
 
-    /// For squared distances `d2` (each below the support squared): r² = r · r with r = √d2 (as
-    /// [`crate::particles::separation`] gives r), the ∇W factor ([`CubicSpline::w_and_grad_factor`]) and W, bit for
-    /// bit as the scalar functions. Branch-free, so that the compiler can evaluate several pairs at once.
-    pub fn pair_values(&self, d2: &[f64], r2: &mut [f64], grad: &mut [f64], w: &mut [f64]) {
-        let (h, alpha) = (self.h, self.alpha);
-        for (((&d2, r2), g), w) in d2.iter().zip(r2).zip(grad).zip(w) {
+    /// For squared distances `d2` (each below the support squared): the ∇W factor
+    /// ([`CubicSpline::w_and_grad_factor`]) at r = √d2 (as [`crate::particles::separation`] gives r), bit for bit
+    /// as the scalar function. Branch-free, so that the compiler can evaluate several pairs at once.
+    pub fn grad_factors(&self, d2: &[f64], grad: &mut [f64]) {
+        let h = self.h;
+        let alpha = self.alpha;
+        for (&d2, g) in d2.iter().zip(grad) {
             let r = d2.sqrt();
             let q = r / h;
             let t = 2.0 - q;
-            let (w_near, dq_near) = (
-                alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q),
-                alpha * (-3.0 * q + 2.25 * q * q),
-            );
-            let (w_far, dq_far) = (alpha * 0.25 * t * t * t, -0.75 * alpha * t * t);
-            let near = q < 1.0;
-            let inside = q < 2.0;
-            let wv = if near {
-                w_near
-            } else if inside {
-                w_far
-            } else {
-                0.0
-            };
-            let dq = if near {
+            let dq_near = alpha * (-3.0 * q + 2.25 * q * q);
+            let dq_far = -0.75 * alpha * t * t;
+            let dq = if q < 1.0 {
                 dq_near
-            } else if inside {
+            } else if q < 2.0 {
                 dq_far
             } else {
                 0.0
             };
             let f = dq / h / r;
             *g = if r > 0.0 { f } else { 0.0 };
-            *w = wv;
-            *r2 = r * r;
         }
     }
 
@@ -155,11 +142,9 @@ mod tests {
                 assert_eq!(f.to_bits(), (k.dw_dr(r) / r).to_bits(), "factor at r = {r}");
             }
             let d2 = [r * r];
-            let (mut r2, mut g, mut wv) = ([0.0], [0.0], [0.0]);
-            k.pair_values(&d2, &mut r2, &mut g, &mut wv);
+            let mut g = [0.0];
+            k.grad_factors(&d2, &mut g);
             let rr = d2[0].sqrt();
-            assert_eq!(r2[0].to_bits(), (rr * rr).to_bits());
-            assert_eq!(wv[0].to_bits(), k.w(rr).to_bits(), "W at r = {rr}");
             assert_eq!(
                 g[0].to_bits(),
                 k.w_and_grad_factor(rr).1.to_bits(),

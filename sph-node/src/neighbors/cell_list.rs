@@ -136,21 +136,24 @@ impl CellList {
 /// Particles per chunk of a [`NeighborList`] (a power of two): the unit of parallel work and of storage.
 pub const CHUNK: usize = 256;
 
-/// The neighbour lists of [`CHUNK`] consecutive particles, stored together, with optional kernel factors per pair.
+/// The neighbour lists of [`CHUNK`] consecutive particles, stored together, with an optional ∇W factor per pair.
+///
+/// Only what cannot be recomputed cheaply is kept per pair (4 + 8 bytes): r² and W follow from the positions,
+/// which do not move between a search and the passes that use its lists, with the builder's own arithmetic
+/// (see [`ListChunk::grad`]). The pair arrays grow to an estimate of what the chunk needs (not by doubling) and
+/// keep their capacity from list to list.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ListChunk {
     /// First particle of the chunk.
     first: usize,
+    /// Number of particles the chunk is being filled with (for the capacity estimate).
+    particles: usize,
     /// `start[k]..start[k + 1]` indexes the pair arrays for particle `first + k`.
     start: Vec<u32>,
     /// Neighbour indices.
     pub idx: Vec<u32>,
     /// ∇W factor per pair (see [`ListChunk::grad`]); longer than `idx` when it held more pairs before.
     grad: Vec<f64>,
-    /// r² per pair (see [`ListChunk::r2`]); as `grad`.
-    r2: Vec<f64>,
-    /// W per pair (see [`ListChunk::w`]); as `grad`.
-    w: Vec<f64>,
     /// The builder evaluated the kernel ([`ListChunk::kernel_values`]) since the chunk was cleared.
     kernel_written: bool,
     /// Candidate indices of the particle being gathered (builder scratch).
@@ -190,33 +193,24 @@ impl ListChunk {
         &self.idx[self.range(k)]
     }
 
-    fn clear(&mut self, first: usize) {
+    fn clear(&mut self, first: usize, particles: usize) {
         self.first = first;
+        self.particles = particles;
         self.kernel_written = false;
         self.start.clear();
         self.start.push(0);
         self.idx.clear();
-        // The kernel values keep their length, to be overwritten in place ([`ListChunk::kernel_values`]) and cut
-        // to the pair count at the end of the chunk.
+        // The ∇W factors keep their length, to be overwritten in place ([`ListChunk::kernel_values`]) and read up
+        // to the pair count.
     }
 
     /// The ∇W factor of every pair, dW/dr(r)/r (∇_i W_ij = factor · r_ij), when the builder evaluated the kernel
-    /// (else empty); indexed as `idx`.
+    /// (else empty); indexed as `idx`. The builder takes r = √d², d² = dx · dx + dy · dy with (dx, dy) = x_i − x_j
+    /// (as [`crate::particles::separation`]); a pass that needs r² or W recomputes them from the same positions with
+    /// that arithmetic, bit for bit what the builder saw.
     #[inline]
     pub fn grad(&self) -> &[f64] {
         &self.grad[..self.kernel_len()]
-    }
-
-    /// r² of every pair (r · r, r = |r_ij| as [`crate::particles::separation`] computes it), as [`ListChunk::grad`].
-    #[inline]
-    pub fn r2(&self) -> &[f64] {
-        &self.r2[..self.kernel_len()]
-    }
-
-    /// W(r) of every pair, as [`ListChunk::grad`].
-    #[inline]
-    pub fn w(&self) -> &[f64] {
-        &self.w[..self.kernel_len()]
     }
 
     fn kernel_len(&self) -> usize {
@@ -227,23 +221,41 @@ impl ListChunk {
         }
     }
 
-    /// (∇W factor, r², W) slices for the pairs `start..start + n`, for a builder that evaluates the kernel to fill
-    /// (the storage is reused from list to list without being zeroed first).
+    /// Capacity for `n` more pairs in `idx` (and in the ∇W factors when `kernel`), grown to an estimate of the
+    /// whole chunk: the pairs so far, plus as many per remaining particle as the particles so far had on average,
+    /// plus 1/32. Exact reservations, so that the pair arrays are not up to twice what the chunk needs, as
+    /// doubling growth leaves them.
     #[inline]
-    pub fn kernel_values(&mut self, start: usize, n: usize) -> (&mut [f64], &mut [f64], &mut [f64]) {
+    pub fn reserve_pairs(&mut self, n: usize, kernel: bool) {
+        let end = self.idx.len() + n;
+        let fits = |cap: usize| cap >= end;
+        if fits(self.idx.capacity()) && (!kernel || fits(self.grad.len())) {
+            return;
+        }
+        let done = self.start.len(); // particles closed, plus the one being gathered
+        let remaining = self.particles.saturating_sub(done);
+        let estimate = end + end.div_ceil(done) * remaining;
+        let want = estimate + estimate / 32;
+        if !fits(self.idx.capacity()) {
+            self.idx.reserve_exact(want - self.idx.len());
+        }
+        if kernel && !fits(self.grad.len()) {
+            self.grad.reserve_exact(want - self.grad.len());
+            // Every entry is overwritten before it is read.
+            self.grad.resize(want, 0.0);
+        }
+    }
+
+    /// The ∇W factors for the pairs `start..start + n`, for a builder that evaluates the kernel to fill (the
+    /// storage is reused from list to list without being zeroed first; [`ListChunk::reserve_pairs`] grows it).
+    #[inline]
+    pub fn kernel_values(&mut self, start: usize, n: usize) -> &mut [f64] {
         let end = start + n;
         self.kernel_written = true;
-        if self.r2.len() < end {
-            let len = end + end / 32;
-            self.grad.resize(len, 0.0);
-            self.r2.resize(len, 0.0);
-            self.w.resize(len, 0.0);
+        if self.grad.len() < end {
+            self.grad.resize(end, 0.0);
         }
-        (
-            &mut self.grad[start..end],
-            &mut self.r2[start..end],
-            &mut self.w[start..end],
-        )
+        &mut self.grad[start..end]
     }
 
     fn close_particle(&mut self) {
@@ -261,8 +273,9 @@ pub struct NeighborList {
 
 impl NeighborList {
     /// Rebuilds the lists of particles `0..n`, reusing the allocations: `gather(i, chunk)` appends the neighbours
-    /// of particle i to `chunk.idx` (and, if it evaluates the kernel, fills their values through
-    /// [`ListChunk::kernel_values`], for every particle of the chunk). Chunks are filled in parallel; the lists do not depend on the thread count.
+    /// of particle i to `chunk.idx` (and, if it evaluates the kernel, fills their ∇W factors through
+    /// [`ListChunk::kernel_values`], for every particle of the chunk). Chunks are filled in parallel; the lists do
+    /// not depend on the thread count.
     pub fn build<F>(&mut self, n: usize, gather: F)
     where
         F: Fn(usize, &mut ListChunk) + Sync,
@@ -273,8 +286,9 @@ impl NeighborList {
         self.chunks.resize_with(n_chunks, ListChunk::default);
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
             let first = c * CHUNK;
-            chunk.clear(first);
-            for i in first..(first + CHUNK).min(n) {
+            let last = (first + CHUNK).min(n);
+            chunk.clear(first, last - first);
+            for i in first..last {
                 gather(i, chunk);
                 chunk.close_particle();
             }
@@ -313,7 +327,7 @@ impl NeighborList {
             .iter()
             .map(|c| {
                 4 * (c.start.capacity() + c.idx.capacity() + c.cand_idx.capacity())
-                    + 8 * (c.grad.capacity() + c.r2.capacity() + c.w.capacity() + c.cand_d2.capacity())
+                    + 8 * (c.grad.capacity() + c.cand_d2.capacity())
             })
             .sum()
     }

@@ -216,13 +216,13 @@ impl SortedCells {
     }
 
     /// Neighbour lists (self excluded) of the fluid particles `0..n_fluid` of `x` (sorted fluid first, then the
-    /// walls), each with the kernel values of its pairs ([`ListChunk::grad`], [`ListChunk::r2`], [`ListChunk::w`]);
+    /// walls), each with the ∇W factors of its pairs ([`ListChunk::grad`]);
     /// neighbours are the particles closer than `kernel.support()`, in the order of the module documentation.
     pub fn build_fluid_lists(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, list: &mut NeighborList) {
         list.build(n_fluid, |i, chunk| self.gather_fluid(x, n_fluid, kernel, i, chunk));
     }
 
-    /// Appends the neighbours of fluid slot i, with their kernel values, to `chunk`.
+    /// Appends the neighbours of fluid slot i, with their ∇W factors, to `chunk`.
     #[inline]
     fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {
         let radius = kernel.support();
@@ -272,11 +272,11 @@ impl SortedCells {
             }
         }
         let start = chunk.idx.len();
+        chunk.reserve_pairs(n, true);
         chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
-        // r as `separation` computes it; W and the ∇W factor as `CubicSpline::w` and `::grad`.
+        // r as `separation` computes it; the ∇W factor as `CubicSpline::grad`.
         let d2 = std::mem::take(&mut chunk.cand_d2);
-        let (grad, r2, w) = chunk.kernel_values(start, n);
-        kernel.pair_values(&d2[..n], r2, grad, w);
+        kernel.grad_factors(&d2[..n], chunk.kernel_values(start, n));
         chunk.cand_d2 = d2;
     }
 

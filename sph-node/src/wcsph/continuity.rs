@@ -31,7 +31,7 @@ pub fn density_rates_into(view: &ParticleView<'_>, list: &NeighborList, kernel: 
         .collect_into_vec(out);
 }
 
-/// [`density_rate`] with the kernel factors of the pairs precomputed (`grad[k]`: ∇W factor of pair
+/// [`density_rate`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair
 /// (i, `neighbors[k]`), see [`crate::neighbors::ListChunk`]) and `vol[j]` = m_j/ρ_j: the same sum, bit for bit.
 #[inline]
 pub fn density_rate_pairs(i: usize, view: &ParticleView<'_>, vol: &[f64], neighbors: &[u32], grad: &[f64]) -> f64 {
@@ -48,7 +48,7 @@ pub fn density_rate_pairs(i: usize, view: &ParticleView<'_>, vol: &[f64], neighb
     view.rho[i] * sum // Eq. (9), Long et al. 2016
 }
 
-/// Dρ/Dt of every fluid particle into `out` from lists with kernel factors (as built by
+/// Dρ/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j.
 pub fn density_rates_pairs_into(view: &ParticleView<'_>, vol: &[f64], list: &NeighborList, out: &mut Vec<f64>) {
     out.resize(view.n_fluid, 0.0); // every entry is overwritten

@@ -89,19 +89,24 @@ pub fn accelerations_into(
         .collect_into_vec(out);
 }
 
-/// The pairs of one particle with their precomputed kernel factors (see [`crate::neighbors::ListChunk`]).
+/// The pairs of one particle with their precomputed ∇W factors (see [`crate::neighbors::ListChunk`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Pairs<'a> {
     /// Neighbour indices.
     pub idx: &'a [u32],
     /// ∇W factors: ∇_i W_ij = grad · r_ij.
     pub grad: &'a [f64],
-    /// r_ij².
-    pub r2: &'a [f64],
 }
 
-/// [`acceleration`] with the kernel factors of the pairs precomputed and `pr2[j]` = p_j/ρ_j²: the same sums,
-/// bit for bit.
+/// r² = r · r with r = |r_ij| as [`separation`] computes it (the r² of [`acceleration`], bit for bit).
+#[inline]
+fn r2_of(r_ij: [f64; 2]) -> f64 {
+    let r = (r_ij[0] * r_ij[0] + r_ij[1] * r_ij[1]).sqrt();
+    r * r
+}
+
+/// [`acceleration`] with the ∇W factors of the pairs precomputed and `pr2[j]` = p_j/ρ_j²: the same sums, bit
+/// for bit (r² is recomputed from the positions, as [`acceleration`] does).
 #[inline]
 pub fn acceleration_pairs(
     i: usize,
@@ -114,7 +119,7 @@ pub fn acceleration_pairs(
     let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
     let pi_term = pr2[i];
     let mut a = [0.0, 0.0];
-    for ((&j, &g), &r2) in pairs.idx.iter().zip(pairs.grad).zip(pairs.r2) {
+    for (&j, &g) in pairs.idx.iter().zip(pairs.grad) {
         let j = j as usize;
         let xj = view.x[j];
         let r_ij = [xi[0] - xj[0], xi[1] - xj[1]];
@@ -122,7 +127,14 @@ pub fn acceleration_pairs(
         let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
         let rho_j = view.rho[j];
         let visc = if params.alpha > 0.0 {
-            pi_ij(params.alpha, params.c0, h, dot(v_ij, r_ij), 0.5 * (rho_i + rho_j), r2)
+            pi_ij(
+                params.alpha,
+                params.c0,
+                h,
+                dot(v_ij, r_ij),
+                0.5 * (rho_i + rho_j),
+                r2_of(r_ij),
+            )
         } else {
             0.0
         };
@@ -132,14 +144,14 @@ pub fn acceleration_pairs(
         a[1] -= f * grad[1];
     }
     if params.nu > 0.0 {
-        for ((&j, &g), &r2) in pairs.idx.iter().zip(pairs.grad).zip(pairs.r2) {
+        for (&j, &g) in pairs.idx.iter().zip(pairs.grad) {
             let j = j as usize;
             let xj = view.x[j];
             let r_ij = [xi[0] - xj[0], xi[1] - xj[1]];
             let grad = [g * r_ij[0], g * r_ij[1]];
             let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
             // Eq. (12), Long et al. 2016, ν_i = ν_j = ν
-            let f = morris_factor(view.m[j], 2.0 * params.nu, dot(r_ij, grad), view.rho[j], r2, h);
+            let f = morris_factor(view.m[j], 2.0 * params.nu, dot(r_ij, grad), view.rho[j], r2_of(r_ij), h);
             a[0] += f * v_ij[0];
             a[1] += f * v_ij[1];
         }
@@ -148,7 +160,7 @@ pub fn acceleration_pairs(
     [a[0] + params.gravity[0], a[1] + params.gravity[1]]
 }
 
-/// Dv/Dt of every fluid particle into `out` from lists with kernel factors (as built by
+/// Dv/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `pr2[j]` = p_j/ρ_j².
 pub fn accelerations_pairs_into(
     view: &ParticleView<'_>,
@@ -167,8 +179,7 @@ pub fn accelerations_pairs_into(
                 let r = chunk.range(k);
                 let pairs = Pairs {
                     idx: &chunk.idx[r.clone()],
-                    grad: &chunk.grad()[r.clone()],
-                    r2: &chunk.r2()[r],
+                    grad: &chunk.grad()[r],
                 };
                 *o = acceleration_pairs(chunk.first() + k, view, pr2, pairs, h, params);
             }
