@@ -218,6 +218,19 @@ pub(crate) fn particles_writable(n: usize, columns: &[PointField<'_>]) -> bool {
         })
 }
 
+/// The opening of a `.vtu` file as vtkio writes it, up to the `<Piece …>` of `points` points and `cells` cells.
+fn header<W: Write>(out: &mut W, points: usize, cells: usize) -> io::Result<()> {
+    out.write_all(
+        b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
+          <UnstructuredGrid>",
+    )?;
+    write!(
+        out,
+        "<Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" \
+         NumberOfPolys=\"0\" NumberOfVerts=\"0\">"
+    )
+}
+
 /// The `.vtu` file of `n` particles at `x` (one `VTK_VERTEX` cell each, z = 0) with `columns` as point data,
 /// streamed from the parts as they are: byte for byte what [`Checked::write`] writes for the piece
 /// `super::vtk` builds of the same values (the tests compare the two), without that piece or its copies.
@@ -228,15 +241,7 @@ pub(crate) fn write_particles<W: Write>(
     x: &[Part<'_, [f64; 2]>],
     columns: &[PointField<'_>],
 ) -> io::Result<()> {
-    out.write_all(
-        b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
-          <UnstructuredGrid>",
-    )?;
-    write!(
-        out,
-        "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" \
-         NumberOfPolys=\"0\" NumberOfVerts=\"0\">"
-    )?;
+    header(out, n, n)?;
     if columns.is_empty() {
         out.write_all(b"<PointData/>")?;
     } else {
@@ -376,15 +381,7 @@ impl Checked<'_> {
         let piece = self.piece;
         let points = piece.points.len() / 3;
         let cells = piece.cells.types.len();
-        out.write_all(
-            b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\
-              <UnstructuredGrid>",
-        )?;
-        write!(
-            out,
-            "<Piece NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" \
-             NumberOfPolys=\"0\" NumberOfVerts=\"0\">"
-        )?;
+        header(out, points, cells)?;
         attributes(out, "PointData", self.point)?;
         attributes(out, "CellData", self.cell)?;
         out.write_all(b"<Points>")?;
