@@ -208,8 +208,8 @@ impl WcsphSolver {
         };
         let options = WcsphOptions {
             mls: spec.density_filter() == DensityFilter::Mls,
-            // The scene's default is 0 for now: with β = 0.04 still water develops an interior pressure error
-            // (particles pair up at Δx/2 mid-depth; 11 % at mid-depth after 2 s).
+            // The scene's default is 0 for now: with β = 0.04 the 10 s still tank ends 8–11 % off the hydrostatic
+            // pressure (the δ+-SPH shift fights the cubic spline's pairing mode; docs/CORRECTIONS.md).
             apd: spec.apd,
             central_force: 0.0,
         };
