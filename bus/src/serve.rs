@@ -207,7 +207,7 @@ fn serve_session<C: NodeCore>(
         .map_err(zerr)?;
 
     let mut idle_since = std::time::Instant::now();
-    let mut energy_at = idle_since - ENERGY_EVERY;
+    let mut energy_at = idle_since.checked_sub(ENERGY_EVERY).unwrap_or(idle_since);
     // The last command answered and its answer, to answer it again if it comes again.
     let mut last: Option<(Vec<u8>, Vec<u8>)> = None;
     loop {
@@ -273,6 +273,11 @@ fn serve_session<C: NodeCore>(
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
+        idle_since = std::time::Instant::now();
+        let answer = Envelope::new(run, env.step, t, state).encode();
+        state_pub.put(answer.clone()).wait().map_err(zerr)?;
+        last = Some((bytes.into_owned(), answer));
+        // After the answer, off the step's critical path.
         if energy_at.elapsed() >= ENERGY_EVERY {
             let energy: serde_json::Map<String, serde_json::Value> = core
                 .energy()
@@ -288,10 +293,6 @@ fn serve_session<C: NodeCore>(
             board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
             energy_at = std::time::Instant::now();
         }
-        idle_since = std::time::Instant::now();
-        let answer = Envelope::new(run, env.step, t, state).encode();
-        state_pub.put(answer.clone()).wait().map_err(zerr)?;
-        last = Some((bytes.into_owned(), answer));
     }
 }
 

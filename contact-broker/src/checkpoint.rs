@@ -188,6 +188,13 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
         manifest_path.display(),
         manifest.format
     );
+    anyhow::ensure!(
+        scene.scene.run.end_time > manifest.t,
+        "{}: the checkpoint is at t = {} s and run.end_time = {} s: nothing to run (set a later run.end_time)",
+        manifest_path.display(),
+        manifest.t,
+        scene.scene.run.end_time
+    );
     let scene_path = dir.join("scene.toml");
     let saved_text =
         std::fs::read_to_string(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;

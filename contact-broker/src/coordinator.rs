@@ -236,13 +236,11 @@ fn drive(
     match &plan.restart {
         // Continue where the checkpoint left off: the nodes restored their own states when they started.
         Some(saved) => {
-            (t, step, next_output, next_checkpoint, dt_fluid) = (
-                saved.t,
-                saved.step,
-                saved.next_output,
-                saved.next_checkpoint,
-                saved.dt_fluid,
-            );
+            (t, step, next_output, dt_fluid) = (saved.t, saved.step, saved.next_output, saved.dt_fluid);
+            // From the time, not the saved index: the restart may ask for another interval.
+            next_checkpoint = plan
+                .interval
+                .map_or(saved.next_checkpoint, |i| checkpoint_after(t, i, 0.0));
             pending = Corrections {
                 fem: saved.pending_fem.clone(),
                 sph: saved.pending_sph.clone(),
@@ -327,11 +325,10 @@ fn drive(
             exchanged: last_pass.exchanged as u64,
         });
         // Between two steps: every node answered `step`, its corrections are still to be sent.
+        // The last step too, so that a finished run can be continued further.
         if let Some(interval) = plan.interval {
-            if t >= next_checkpoint as f64 * interval - LANDING * cap {
-                while t >= next_checkpoint as f64 * interval - LANDING * cap {
-                    next_checkpoint += 1;
-                }
+            if t >= next_checkpoint as f64 * interval - LANDING * cap || t >= end {
+                next_checkpoint = checkpoint_after(t, interval, LANDING * cap);
                 let state = BrokerState {
                     step,
                     t,
@@ -364,6 +361,11 @@ fn drive(
     summary.timings.broker += started.elapsed().as_secs_f64();
     written?;
     Ok(())
+}
+
+/// Index k of the first checkpoint time k · `interval` after `t` (times within `slack` before `t` count as reached).
+fn checkpoint_after(t: f64, interval: f64, slack: f64) -> u64 {
+    ((t + slack) / interval + 1e-9).floor() as u64 + 1
 }
 
 /// The run's outputs: the probes and `probes.csv`, the frames (written on their own thread, `output/queue.rs`),

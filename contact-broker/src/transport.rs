@@ -252,9 +252,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                 self.step_timeout.as_secs_f64()
             ))
         })?;
-        let sample = reply
-            .result()
-            .map_err(|e| self.failed(format!("refused the checkpoint: {:?}", e.payload().try_to_string())))?;
+        let sample = reply.result().map_err(|e| {
+            let why = e
+                .payload()
+                .try_to_string()
+                .map_or_else(|_| "(no reason given)".into(), |s| s.into_owned());
+            self.failed(format!("refused the checkpoint: {why}"))
+        })?;
         let env = Envelope::<NodeCheckpoint>::decode(&sample.payload().to_bytes(), &self.run, what)
             .and_then(|e| e.expect_step(step, what))
             .map_err(|e| self.failed(format!("sent an unusable checkpoint: {e}")))?;
@@ -282,6 +286,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                         .and_then(|e| e.expect_step(step, self.topics.state))
                     {
                         Ok(env) => return Ok(env.body),
+                        // An answer to an earlier step, sent again after the broker sent its command again.
+                        Err(CodecError::Step { got, .. }) if got < step => {
+                            tracing::debug!("{}: a repeated answer to step {got}, dropped", self.topics.name);
+                        }
                         Err(e) => {
                             let e: CodecError = e;
                             tracing::error!("{}: refused a state message: {e}", self.topics.name);

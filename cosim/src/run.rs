@@ -92,7 +92,16 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
-    prepare_out(&out, &scene, restart.is_some())?;
+    // A restart into the folder of the run it continues keeps that run's frames; anywhere else they are cleared.
+    let own_folder = restart.as_ref().is_some_and(|r| {
+        let parent = r
+            .dir
+            .canonicalize()
+            .ok()
+            .and_then(|d| d.parent().map(Path::to_path_buf));
+        parent.is_some() && parent == out.join("checkpoints").canonicalize().ok()
+    });
+    prepare_out(&out, &scene, own_folder)?;
     let info = RunInfo {
         run_id,
         mode: if args.in_process { "in-process" } else { "processes" }.into(),
@@ -138,12 +147,20 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
 }
 
 /// Create the folder, clear the outputs of an earlier run there, and keep the resolved scene beside them. A
-/// restart keeps the frames: restarted into the folder of the run it continues, the frames before the checkpoint
-/// stay (and stay listed in the `.pvd` collections); the later ones are written again.
-fn prepare_out(out: &Path, scene: &LoadedScene, restart: bool) -> anyhow::Result<()> {
+/// restart into the folder of the run it continues (`keep_frames`) keeps the frames: those before the checkpoint
+/// stay (and stay listed in the `.pvd` collections); the later ones are written again. The logs of the run that
+/// stopped, which explain why, move to `logs.before-restart`.
+fn prepare_out(out: &Path, scene: &LoadedScene, keep_frames: bool) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
-    let stale_dirs: &[&str] = if restart {
-        &["plots", "logs"]
+    if keep_frames {
+        let (logs, kept) = (out.join("logs"), out.join("logs.before-restart"));
+        if logs.exists() {
+            let _ = std::fs::remove_dir_all(&kept);
+            std::fs::rename(&logs, &kept).with_context(|| format!("cannot keep {}", logs.display()))?;
+        }
+    }
+    let stale_dirs: &[&str] = if keep_frames {
+        &["plots"]
     } else {
         &["frames", "plots", "logs"]
     };

@@ -59,7 +59,10 @@ fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
         for e in std::fs::read_dir(&d).unwrap().flatten() {
             let path = e.path();
             let rel = path.strip_prefix(dir).unwrap().display().to_string();
-            if ["checkpoints", "logs", "summary.json"].iter().any(|s| rel == *s) {
+            if ["checkpoints", "logs", "logs.before-restart", "summary.json"]
+                .iter()
+                .any(|s| rel == *s)
+            {
                 continue;
             }
             if path.is_dir() {
@@ -162,6 +165,10 @@ fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
         4,
         "the restarted run goes on writing checkpoints"
     );
+    assert!(
+        crashed.join("logs.before-restart").join("contact-broker.log").is_file(),
+        "the logs of the run that stopped are kept"
+    );
 
     // The same checkpoint continued in one process.
     let in_process_s = s(&in_process);
@@ -201,10 +208,29 @@ fn isph_restart_is_byte_identical() {
         "run.end_time=0.1",
     ];
     let whole_s = whole.display().to_string();
-    run_ok(&[&base[..], &["--out", &whole_s, "--checkpoint-interval", "0.05"]].concat());
+    run_ok(&[&base[..], &["--out", &whole_s, "--checkpoint-interval", "0.04"]].concat());
+    // At 0.04 and 0.08 s, and at the end (0.1 s), so that a finished run can be continued.
+    let t = |dir: &Path| json(&dir.join("checkpoint.json"))["t"].as_f64().unwrap();
+    let times = |out: &Path| checkpoints(out).iter().map(|(_, d)| t(d)).collect::<Vec<_>>();
+    assert_eq!(times(&whole), [0.04, 0.08, 0.1]);
     let first = checkpoints(&whole).remove(0).1.display().to_string();
     let continued_s = continued.display().to_string();
-    run_ok(&[&base[..], &["--out", &continued_s, "--restart", &first]].concat());
+    // Continued with another interval: the next checkpoints follow it from the restart's time on.
+    run_ok(
+        &[
+            &base[..],
+            &[
+                "--out",
+                &continued_s,
+                "--restart",
+                &first,
+                "--checkpoint-interval",
+                "0.03",
+            ],
+        ]
+        .concat(),
+    );
+    assert_eq!(times(&continued), [0.06, 0.09, 0.1]);
     let probes = |d: &Path| std::fs::read(d.join("probes.csv")).unwrap();
     assert!(probes(&whole).len() > 200, "samples written");
     assert!(probes(&whole) == probes(&continued), "ISPH restart: probes.csv differs");
@@ -260,6 +286,22 @@ fn a_checkpoint_from_another_scene_or_version_is_refused() {
             "[fluid] spacing = 0.005",
             "[fluid] spacing = 0.006",
         ],
+    );
+    // Nothing left to run.
+    refused(
+        &[
+            "run",
+            &gate,
+            "--out",
+            &again,
+            "--set",
+            "fluid.spacing=0.006",
+            "--set",
+            "run.end_time=0.01",
+            "--restart",
+            &ck_s,
+        ],
+        &["checkpoint.json", "nothing to run"],
     );
     // Another scene altogether.
     refused(
