@@ -1,5 +1,6 @@
-//! `cosim run` of a fluid scene that really blows up (`cosim/tests/data/fluid_unstable.toml`: a sound speed 40
-//! times too low, so the water falls through the floor and a particle leaves the fluid's domain), as processes:
+//! `cosim run` of a fluid scene that goes wrong (`cosim/tests/data/fluid_unstable.toml`: a tank with no floor, so
+//! the water falls and the stability guard stops it, its kinetic energy past twice the energy it started with),
+//! as processes:
 //! exit code 1, `summary.json` status `unstable`, one stderr line naming the SPH step, the particle and the
 //! reason, and the frames and probe samples written before the failure kept and readable. The in-process run
 //! reports the same failure.
@@ -11,7 +12,7 @@ use std::time::Duration;
 
 use common::*;
 
-/// The run fails after about 0.34 s of simulated time, about a second of wall time; no test may hang.
+/// The run fails after about 0.2 s of simulated time, under a second of wall time; no test may hang.
 const LIMIT: Duration = Duration::from_secs(60);
 const SCENE: &str = "cosim/tests/data/fluid_unstable.toml";
 /// The scene's `run.end_time`.
@@ -125,7 +126,11 @@ fn a_fluid_blow_up_ends_the_run_unstable_naming_step_particle_and_reason() {
     let (step, particle, reason) = sph_report(&err);
     assert!(step >= 1, "{err}");
     assert!(particle < PARTICLES, "{err}");
-    assert!(reason.starts_with("left the domain at ["), "{err}");
+    // The falling water passes the energy guard's bound (twice the energy it had) before it leaves the domain.
+    assert!(
+        reason.starts_with("left the domain at [") || reason.starts_with("kinetic energy"),
+        "{err}"
+    );
 
     // summary.json: unstable, with the same report, stopped before the end.
     let s = json(&out.join("summary.json"));
