@@ -10,6 +10,7 @@ use cosim_proto::keys::{key, topic, NodeTopics};
 use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
 use cosim_proto::scene::Scene;
 use serde::Serialize;
+use zenoh::bytes::ZBytes;
 use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
 use zenoh::{Session, Wait};
@@ -209,7 +210,7 @@ fn serve_session<C: NodeCore>(
     let mut idle_since = std::time::Instant::now();
     let mut energy_at = idle_since.checked_sub(ENERGY_EVERY).unwrap_or(idle_since);
     // The last command answered and its answer, to answer it again if it comes again.
-    let mut last: Option<(Vec<u8>, Vec<u8>)> = None;
+    let mut last: Option<(Vec<u8>, ZBytes)> = None;
     loop {
         while let Ok(Some(query)) = checkpoints.try_recv() {
             // Between two steps: the state after step `expected - 1`, before the corrections of the next.
@@ -274,7 +275,8 @@ fn serve_session<C: NodeCore>(
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
         idle_since = std::time::Instant::now();
-        let answer = Envelope::new(run, env.step, t, state).encode();
+        // A shared buffer: keeping it to answer a repeat costs no copy.
+        let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode());
         state_pub.put(answer.clone()).wait().map_err(zerr)?;
         last = Some((bytes.into_owned(), answer));
         // After the answer, off the step's critical path.

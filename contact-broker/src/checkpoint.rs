@@ -109,6 +109,17 @@ pub struct Written {
     pub seconds: f64,
 }
 
+/// Refuse a `--checkpoint-interval` that is not a positive number of seconds.
+pub fn check_interval(interval: Option<f64>) -> anyhow::Result<()> {
+    if let Some(i) = interval {
+        anyhow::ensure!(
+            i.is_finite() && i > 0.0,
+            "--checkpoint-interval must be a positive number of seconds, got {i}"
+        );
+    }
+    Ok(())
+}
+
 /// Write `out/checkpoints/<step>/`. `nodes` are `("fem", bytes)` and/or `("sph", bytes)`; `started` is when the
 /// checkpoint began (before the nodes were asked), for the manifest's `write_seconds`.
 pub fn write(

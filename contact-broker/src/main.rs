@@ -86,12 +86,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     );
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
     coordinator::check_supported(&scene)?;
-    if let Some(i) = args.checkpoint_interval {
-        anyhow::ensure!(
-            i.is_finite() && i > 0.0,
-            "--checkpoint-interval must be a positive number of seconds, got {i}"
-        );
-    }
+    checkpoint::check_interval(args.checkpoint_interval)?;
     let restart = match &args.restart {
         Some(dir) => Some(checkpoint::open(dir, &scene)?),
         None => None,

@@ -7,6 +7,7 @@ use cosim_proto::envelope::{CodecError, Envelope};
 use cosim_proto::keys::{key, topic, NodeTopics};
 use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
 use serde::de::DeserializeOwned;
+use zenoh::bytes::ZBytes;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
@@ -104,7 +105,7 @@ pub struct ZenohLink<S, T> {
     alive: Sub,
     step_timeout: Duration,
     /// The last command sent (its step and bytes), to send again when its answer does not come.
-    last_command: Option<(u64, Vec<u8>)>,
+    last_command: Option<(u64, ZBytes)>,
     _state: std::marker::PhantomData<T>,
 }
 
@@ -229,7 +230,8 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
     }
 
     fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
-        let bytes = Envelope::new(&self.run, step, t, cmd).encode();
+        // A shared buffer: keeping it to send again costs no copy.
+        let bytes = ZBytes::from(Envelope::new(&self.run, step, t, cmd).encode());
         self.command
             .put(bytes.clone())
             .wait()

@@ -67,12 +67,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             args.wait_external
         );
     }
-    if let Some(i) = args.checkpoint_interval {
-        anyhow::ensure!(
-            i.is_finite() && i > 0.0,
-            "--checkpoint-interval must be a positive number of seconds, got {i}"
-        );
-    }
+    checkpoint::check_interval(args.checkpoint_interval)?;
     if let (Some(node), true) = (
         args.external,
         args.checkpoint_interval.is_some() || args.restart.is_some(),
