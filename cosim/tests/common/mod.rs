@@ -1,6 +1,7 @@
 //! Shared helpers of the end-to-end tests: run the real binaries with a bounded wait.
 #![allow(dead_code)]
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -39,9 +40,11 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Run a command, killing it after `limit`; panics on a timeout so no test can hang.
+/// Run a command, killing it after `limit`; panics on a timeout so no test can hang. The command runs in its own
+/// process group, and a timeout kills the whole group: `cosim run` and the nodes it started, none left behind.
 pub fn run_bounded(cmd: &mut Command, limit: Duration) -> Output {
     let mut child = cmd
+        .process_group(0)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -53,6 +56,8 @@ pub fn run_bounded(cmd: &mut Command, limit: Duration) -> Output {
             return child.wait_with_output().unwrap();
         }
         if start.elapsed() > limit {
+            let group = format!("-{}", child.id());
+            let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
             let _ = child.kill();
             let out = child.wait_with_output().unwrap();
             panic!(
