@@ -10,10 +10,14 @@
 //!   so far, the summary's counters;
 //! - `fem.bin`, `sph.bin`: each node's own state, as the node saved it (opaque here, `docs/PROTOCOL.md` §9).
 //!
-//! The folder is written under a temporary name and renamed when complete, so a run that dies while it writes
-//! never leaves a half checkpoint that looks whole. Pure: files only, no messaging.
+//! The folder is written under a temporary name (`.<step>.<pid>.partial`, so that two runs writing into one
+//! folder by mistake do not write into each other's), each file and the folder are flushed to the disk
+//! (`fsync`), and only then is it renamed: a run, or a machine, that dies while it writes never leaves a half
+//! checkpoint that looks whole. [`open`] checks every file's size against the manifest, so a checkpoint damaged
+//! afterwards (a copy cut short, a full disk) is refused naming the file. Pure: files only, no messaging.
 
 use std::collections::BTreeMap;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -132,7 +136,7 @@ pub fn write(
 ) -> anyhow::Result<Written> {
     let root = out.join("checkpoints");
     let dir = root.join(state.step.to_string());
-    let tmp = root.join(format!(".{}.partial", state.step));
+    let tmp = root.join(format!(".{}.{}.partial", state.step, std::process::id()));
     if tmp.exists() {
         std::fs::remove_dir_all(&tmp).with_context(|| format!("cannot clear {}", tmp.display()))?;
     }
@@ -140,7 +144,7 @@ pub fn write(
     let mut files = BTreeMap::new();
     let mut put = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
         let path = tmp.join(name);
-        std::fs::write(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+        write_synced(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
         files.insert(name.to_string(), bytes.len() as u64);
         Ok(())
     };
@@ -163,16 +167,32 @@ pub fn write(
     manifest.write_seconds = started.elapsed().as_secs_f64();
     let text = serde_json::to_string_pretty(&manifest)? + "\n";
     let path = tmp.join(MANIFEST);
-    std::fs::write(&path, &text).with_context(|| format!("cannot write {}", path.display()))?;
+    write_synced(&path, text.as_bytes()).with_context(|| format!("cannot write {}", path.display()))?;
+    sync_dir(&tmp)?;
     if dir.exists() {
         std::fs::remove_dir_all(&dir).with_context(|| format!("cannot replace {}", dir.display()))?;
     }
     std::fs::rename(&tmp, &dir).with_context(|| format!("cannot rename {} to {}", tmp.display(), dir.display()))?;
+    sync_dir(&root)?;
     Ok(Written {
         bytes: manifest.files.values().sum::<u64>() + text.len() as u64,
         dir,
         seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Write `bytes` to `path` and flush them to the disk before returning.
+fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut file = std::fs::File::create(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()
+}
+
+/// Flush a folder's entries (the names of the files in it, a rename) to the disk.
+fn sync_dir(dir: &Path) -> anyhow::Result<()> {
+    std::fs::File::open(dir)
+        .and_then(|d| d.sync_all())
+        .with_context(|| format!("cannot flush {} to the disk", dir.display()))
 }
 
 /// Read the checkpoint `dir` and check that `scene` may continue from it: same format and protocol version, and
@@ -206,6 +226,18 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
         manifest.t,
         scene.scene.run.end_time
     );
+    for (name, size) in &manifest.files {
+        let path = dir.join(name);
+        let len = std::fs::metadata(&path)
+            .with_context(|| format!("{}: missing, {} lists it", path.display(), manifest_path.display()))?
+            .len();
+        anyhow::ensure!(
+            len == *size,
+            "{}: {len} bytes where {} says {size}: the checkpoint is damaged (cut short or changed)",
+            path.display(),
+            manifest_path.display()
+        );
+    }
     let scene_path = dir.join("scene.toml");
     let saved_text =
         std::fs::read_to_string(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;

@@ -335,6 +335,29 @@ fn a_checkpoint_from_another_scene_or_version_is_refused() {
         ],
         &["checkpoint.json", "protocol version 7"],
     );
+    // A damaged copy: sph.bin cut short.
+    let damaged = dir.join("damaged");
+    std::fs::create_dir_all(&damaged).unwrap();
+    for e in std::fs::read_dir(&ck).unwrap().flatten() {
+        std::fs::copy(e.path(), damaged.join(e.file_name())).unwrap();
+    }
+    let sph = damaged.join("sph.bin");
+    let bytes = std::fs::read(&sph).unwrap();
+    std::fs::write(&sph, &bytes[..bytes.len() - 1]).unwrap();
+    let damaged_s = damaged.display().to_string();
+    refused(
+        &[
+            "run",
+            &gate,
+            "--out",
+            &again,
+            "--set",
+            "fluid.spacing=0.006",
+            "--restart",
+            &damaged_s,
+        ],
+        &["sph.bin", "damaged", &format!("{} bytes", bytes.len() - 1)],
+    );
     // Not a checkpoint folder.
     refused(
         &["run", &gate, "--out", &again, "--restart", &out_s],
