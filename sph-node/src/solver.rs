@@ -18,6 +18,7 @@ use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::boundary::repulsion::Repulsion;
 use crate::boundary::{adami, walls};
 use crate::corrections::{apd, density_filter, mls};
 use crate::eos::Tait;
@@ -216,6 +217,9 @@ impl WcsphSolver {
         let mut solver = Self::from_particles(params, options, state, walls)?;
         solver.cfl = spec.cfl;
         solver.wall_boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
+        // The initial accelerations again, with the walls' repulsion (none unless a block starts within its range).
+        solver.update_pressure_and_acceleration();
+        solver.write_back();
         Ok(solver)
     }
 
@@ -323,9 +327,10 @@ impl WcsphSolver {
     /// The particle state, for corrections applied from outside (contact, `DESIGN.md` §3 step 5). Positions and
     /// velocities may change; the particle count and order may not.
     ///
-    /// The next [`WcsphSolver::step`] takes v, ρ and p as they then are, and drifts from the edited positions;
-    /// as it always has, that step's first density rate and XSPH still use the positions and neighbours of the
-    /// last neighbour search, and its first kick the accelerations of the last step. (m is not re-read.)
+    /// The next [`WcsphSolver::step`] takes v, ρ and p as they then are, changes ρ for the edited positions as
+    /// the continuity equation would (see `density_follows_edits`), and drifts from the edited positions; as it
+    /// always has, that step's first density rate and XSPH still use the positions and neighbours of the last
+    /// neighbour search, and its first kick the accelerations of the last step. (m is not re-read.)
     pub fn state_mut(&mut self) -> &mut FluidState {
         self.state_edited = true;
         &mut self.state
@@ -341,14 +346,13 @@ impl WcsphSolver {
     /// ([`WallBoxes::push_out`], the guard ISPH uses): (over the whole run, in the last step). Each particle
     /// counts once per drift that put it in a wall.
     ///
-    /// A last line of defence, not the wall model: the Adami walls (§4.7) hold water at rest and most flows, but
-    /// they act only through the pressure, and a fluid particle's density (continuity, Shepard-filtered over the
-    /// fluid) does not rise with its overlap of the wall particles. A particle the flow drives into a wall slowly
-    /// (in the tall dam break of `cosim/tests/stress.rs`, at 0.7 m/s where the fluid's pressure exceeds the
-    /// extrapolated wall pressure) finds no force against it once it sits among the wall particles, and a particle
-    /// in tension (p < 0) is drawn in further; unguarded, water seeped into the walls from t ≈ 0.19 s and a
-    /// particle came out of the tank's back corner at 1.88 s. Runs in which no particle enters a wall are
-    /// unchanged, bit for bit.
+    /// A last line of defence, not the wall model: the Adami walls (§4.7) act only through the pressure, which
+    /// mirrors the fluid's, so a layer pressed against a wall settles wherever its neighbourhood balances, on the
+    /// face itself; the short-range repulsion of [`crate::boundary::repulsion`] keeps the water out. Before it, the
+    /// guard put particles back 144,955 times in the tall dam break of `sph-node/tests/wall_guard.rs` and about
+    /// 1,450 times in the hydrostatic plate scene; with it, none in either. Unguarded and without the repulsion,
+    /// water seeped into the walls from t ≈ 0.19 s and a particle came out of the tank's back corner at 1.88 s.
+    /// Runs in which no particle enters a wall are unchanged by the guard, bit for bit.
     pub fn wall_pushes(&self) -> (u64, u64) {
         self.wall_pushes
     }
@@ -478,6 +482,9 @@ impl WcsphSolver {
     fn advance(&mut self, dt: f64) -> Result<()> {
         let step_no = self.state.step + 1;
         let nf = self.state.len();
+        if !self.scratch.edited_x.is_empty() {
+            self.density_follows_edits();
+        }
         // Kick.
         integrator::half_kick(&mut self.sorted.v[..nf], &self.sorted.accel, dt);
         // Density drifts with the positions: its rate uses v^{n+½} at both ends of the step (trapezoid in x).
@@ -579,6 +586,36 @@ impl WcsphSolver {
             .sum()
     }
 
+    /// ρ follows the positions edited through [`WcsphSolver::state_mut`] (the contact's corrections, `DESIGN.md` §3
+    /// step 5) as the continuity equation would follow the same displacement (Eq. (9) with δr for v Δt, as for the
+    /// APD shift: [`apd::shift_density_change`]), at the positions and neighbours of the last search.
+    ///
+    /// Without it a position correction moves a particle without any change of density: the contact, which puts
+    /// every particle it finds inside the structure back on the same line r_c in front of its face, stacked particles
+    /// up in front of the elastic gate's tip at Δx = 5 mm (some 20 in a few mm², at pressures of a few kPa), until the
+    /// stack blew apart and the energy guard stopped the run (`cosim/tests/stress.rs`,
+    /// `coarse_elastic_gate_keeps_its_water_on_the_floor`).
+    fn density_follows_edits(&mut self) {
+        let nf = self.state.len();
+        let mut shift = std::mem::take(&mut self.scratch.per2);
+        shift.clear();
+        let s = &self.sorted;
+        shift.extend(
+            self.scratch
+                .edited_x
+                .iter()
+                .zip(&s.x[..nf])
+                .map(|(e, x)| [e[0] - x[0], e[1] - x[1]]),
+        );
+        let mut drho = std::mem::take(&mut self.scratch.per1);
+        apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
+        let s = &mut self.sorted;
+        s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
+        self.scratch.per1 = drho;
+        self.scratch.per2 = shift;
+    }
+
     /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9)).
     fn density_half_kick(&mut self, dt: f64) {
         let nf = self.state.len();
@@ -654,6 +691,10 @@ impl WcsphSolver {
                     a[0] -= k * x[0];
                     a[1] -= k * x[1];
                 });
+        }
+        if !self.wall_boxes.boxes().is_empty() {
+            // Short-range wall repulsion (boundary/repulsion.rs)
+            Repulsion::new(self.params.dx, self.params.c0).add_into(&self.wall_boxes, &self.sorted.x[..nf], &mut accel);
         }
         self.sorted.accel = accel;
     }
@@ -919,15 +960,21 @@ mod tests {
         }
         assert_eq!(a.state(), b.state());
         // Move particle 0: the step's first density rate and XSPH use the last search's positions, as they
-        // always have, and the drift starts from the edited one; so only particle 0 lands elsewhere.
+        // always have, and the drift starts from the edited one; the densities of particle 0 and its neighbours
+        // follow the move (`density_follows_edits`), and the step's first density rate carries that 2h further,
+        // which changes the XSPH of the particles within 2h of those (2.4e-10 m for particle 0 here): particle 0
+        // lands 1e-4 m further, and every particle beyond 6h lands where it did.
         let x0 = a.state().x[0];
         a.state_mut().x[0] = [x0[0] + 1e-4, x0[1]];
         let dt = a.stable_dt();
         a.step(dt).unwrap();
         b.step(dt).unwrap();
         let (xa, xb) = (&a.state().x, &b.state().x);
-        assert!((xa[0][0] - xb[0][0] - 1e-4).abs() < 1e-12 && xa[0][1] == xb[0][1]);
-        assert_eq!(xa[1..], xb[1..]);
+        assert!((xa[0][0] - xb[0][0] - 1e-4).abs() < 1e-8 && (xa[0][1] - xb[0][1]).abs() < 1e-8);
+        let far = 3.0 * a.kernel.support();
+        let beyond: Vec<usize> = (1..xa.len()).filter(|&i| separation(xb[i], x0).1 > far).collect();
+        assert!(beyond.len() > xa.len() / 2);
+        assert!(beyond.iter().all(|&i| xa[i] == xb[i]));
         assert_ne!(a.state().v, b.state().v);
         // The neighbour lists are those of the new positions.
         let list = &a.scratch.list;
@@ -935,6 +982,38 @@ mod tests {
         let cells = CellList::new(view.x, a.kernel.support());
         let reference = cells.neighbor_list(view.x, view.x.len(), a.kernel.support());
         assert!((0..view.n_fluid).all(|i| list.of(i) == reference.of(i)));
+    }
+
+    /// A position edit raises the density of a particle moved towards its neighbours as the continuity equation
+    /// would (`density_follows_edits`): the top particle of the column, whose neighbours all lie below it, moved
+    /// down by Δx/100 gains δρ = Σ_j m_j δr·∇W_ij, within 2 % (the rest of the difference is the step's own
+    /// continuity at the two positions).
+    #[test]
+    fn a_position_edit_moves_the_density() {
+        let mut a = dam_break(0.01);
+        let mut b = a.clone();
+        let top = (0..a.state().len())
+            .max_by(|&i, &j| a.state().x[i][1].total_cmp(&a.state().x[j][1]))
+            .unwrap();
+        let dy = -1e-4;
+        let expected = {
+            let view = a.view();
+            let k = a.sorted.slot[top] as usize;
+            let mut shift = vec![[0.0; 2]; view.n_fluid];
+            shift[k] = [0.0, dy];
+            apd::shift_density_change(k, &view, a.scratch.list.of(k), &a.kernel, &shift)
+        };
+        assert!(expected > 1.0, "the top particle is compressed: {expected}");
+        let x = a.state().x[top];
+        a.state_mut().x[top] = [x[0], x[1] + dy];
+        let dt = 1e-6;
+        a.step(dt).unwrap();
+        b.step(dt).unwrap();
+        let gained = a.state().rho[top] - b.state().rho[top];
+        assert!(
+            (gained - expected).abs() < 0.02 * expected,
+            "gained {gained}, expected {expected}"
+        );
     }
 
     /// The solver as it was before the cell-sorted pipeline (id order, plain gathers over a cell list of all
@@ -953,10 +1032,17 @@ mod tests {
         m: Vec<f64>,
         list: NeighborList,
         accel: Vec<[f64; 2]>,
+        boxes: WallBoxes,
     }
 
     impl Reference {
-        fn new(params: SphParams, options: WcsphOptions, state: FluidState, walls: WallParticles) -> Self {
+        fn new(
+            params: SphParams,
+            options: WcsphOptions,
+            state: FluidState,
+            walls: WallParticles,
+            boxes: WallBoxes,
+        ) -> Self {
             let n = state.len() + walls.len();
             let mut r = Self {
                 kernel: CubicSpline::new(params.h),
@@ -972,6 +1058,7 @@ mod tests {
                 p: Vec::new(),
                 list: NeighborList::default(),
                 accel: Vec::new(),
+                boxes,
             };
             r.rebuild();
             r.update();
@@ -1036,16 +1123,33 @@ mod tests {
                 .map(|i| acceleration(i, &view, self.list.of(i), &self.kernel, &params))
                 .collect();
             let k = self.options.central_force;
+            let repulsion = Repulsion::new(self.params.dx, self.params.c0);
             for (a, x) in self.accel.iter_mut().zip(&self.state.x) {
                 if k != 0.0 {
                     a[0] -= k * x[0];
                     a[1] -= k * x[1];
                 }
+                let r = repulsion.acceleration(&self.boxes, *x);
+                a[0] += r[0];
+                a[1] += r[1];
             }
         }
 
         fn step(&mut self, dt: f64) {
             let step_no = self.state.step + 1;
+            let nf = self.state.len();
+            if self.state.x[..] != self.x[..nf] {
+                // Edited positions: ρ follows them as the continuity equation would.
+                let shift: Vec<[f64; 2]> = (0..nf)
+                    .map(|i| [self.state.x[i][0] - self.x[i][0], self.state.x[i][1] - self.x[i][1]])
+                    .collect();
+                self.sync();
+                let view = self.view();
+                let drho: Vec<f64> = (0..nf)
+                    .map(|i| apd::shift_density_change(i, &view, self.list.of(i), &self.kernel, &shift))
+                    .collect();
+                self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+            }
             integrator::half_kick(&mut self.state.v, &self.accel, dt);
             self.continuity(dt);
             let mut corr = Vec::new();
@@ -1118,6 +1222,7 @@ mod tests {
                     solver.options.clone(),
                     solver.state.clone(),
                     solver.walls.clone(),
+                    solver.wall_boxes.clone(),
                 );
                 for step in 0..150 {
                     if step % 25 == 10 {

@@ -49,7 +49,7 @@ trait Tank {
     fn kinetic_energy(&self) -> f64;
     fn pressure_at(&self, point: [f64; 2]) -> f64;
     fn steps(&self) -> u64;
-    /// Particles the last step found inside a wall and put back on its face (ISPH's wall guard).
+    /// Particles the last step found inside a wall and put back on its face (the wall guard of either solver).
     fn wall_pushes(&self) -> usize {
         0
     }
@@ -72,6 +72,9 @@ impl Tank for WcsphSolver {
     }
     fn steps(&self) -> u64 {
         self.state().step
+    }
+    fn wall_pushes(&self) -> usize {
+        WcsphSolver::wall_pushes(self).1 as usize
     }
 }
 

@@ -1,4 +1,5 @@
 //! Rigid walls (`DESIGN.md` §4.7): fixed boundary particles and their pressure.
 
 pub mod adami;
+pub mod repulsion;
 pub mod walls;

@@ -39,6 +39,11 @@ impl WallBoxes {
         }
     }
 
+    /// The boxes, (lower, upper) corner each.
+    pub fn boxes(&self) -> &[([f64; 2], [f64; 2])] {
+        &self.boxes
+    }
+
     /// Whether `x` is strictly inside a box.
     fn inside(&self, x: [f64; 2]) -> bool {
         self.boxes
