@@ -511,9 +511,13 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
 /// The scene's gate (E = 12 MPa) with ISPH at Δx = 4 mm to t = 0.2 s (about 35 s), at the scene's
 /// `coupling.max_dt = 1e-4` s and at 1e-2 s (the coupling never caps the ISPH step): the fluid's energy must stay
 /// within the growth bound, as it does with WCSPH (measured: WCSPH +0.0009 of the budget, then falls steadily).
+/// Measured after the PPE's void rows (`sph-node/src/isph/ppe.rs`): +0.242 of the budget at max_dt 1e-4 (was
+/// +0.24–0.26), +0.145 at 1e-2 (was +0.258). What is left is made on the rows against the gate: their symmetric
+/// gradient pushes them into the face every step (the load path to the structure), and the contact takes most of
+/// it back as it stops them.
 #[test]
-#[ignore = "found by this test: the coupled ISPH gate gains 24-26 % of the fluid's energy budget by t = 0.2 s (most \
-            of it in 0.14-0.16 s, when the tip is kicked) and ends ok"]
+#[ignore = "found by this test: the coupled ISPH gate gains 24 % (max_dt 1e-4) and 15 % (1e-2) of the fluid's \
+            energy budget by t = 0.2 s and ends ok"]
 fn isph_elastic_gate_stays_within_the_energy_bound() {
     let budget = budget(&GATE_BLOCKS);
     let releasable = releasable(&GATE_BLOCKS, GATE_FLOOR);
