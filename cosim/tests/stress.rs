@@ -493,18 +493,19 @@ fn assert_isph_at(factor: f64) {
     }
 }
 
-/// ISPH beyond its own step (scenes cannot ask for it: `fluid.cfl` ≤ 1): at 4 × it ends finite and loses energy
-/// (measured: no growth at all), at 8 × the energy guard stops it a few steps in.
+/// ISPH beyond its own step (scenes cannot ask for it: `fluid.cfl` ≤ 1): at 4 × it ends finite within the bound
+/// (measured: +0.005 of the budget at the impact), at 8 × the energy guard stops it a few steps in.
 #[test]
 fn isph_far_beyond_its_step_stays_bounded_or_stops_with_a_reason() {
     assert_isph_at(4.0);
     assert_isph_at(8.0);
 }
 
-/// At 2 × its step ISPH ends finite but gains 7.6 % of its energy budget at the impact (at 1 ×, 3.3 %), and no
-/// guard stops it (the energy guard allows kinetic energy up to twice the budget).
+/// At 2 × its step ISPH once gained 7.6 % of its energy budget in one step at the impact on the far wall (t =
+/// 0.169 s): the top of the thin sheet that hits the wall, not a free surface by ∇·r next to the walls, took 19 kPa
+/// from a PPE row that left its void out and was thrown up at 5 m/s by the corrector's symmetric gradient. The PPE
+/// rows now count the void as p = 0 (`sph-node/src/isph/ppe.rs`, `fluid_row`); measured: +0.0002 of the budget.
 #[test]
-#[ignore = "found by this test: ISPH at 2x its step gains 7.6 % of the energy budget at the impact and ends ok"]
 fn isph_at_twice_its_step_stays_within_the_energy_bound() {
     assert_isph_at(2.0);
 }
@@ -512,9 +513,13 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
 /// The scene's gate (E = 12 MPa) with ISPH at Δx = 4 mm to t = 0.2 s (about 35 s), at the scene's
 /// `coupling.max_dt = 1e-4` s and at 1e-2 s (the coupling never caps the ISPH step): the fluid's energy must stay
 /// within the growth bound, as it does with WCSPH (measured: WCSPH +0.0009 of the budget, then falls steadily).
+/// Measured after the PPE's void rows (`sph-node/src/isph/ppe.rs`): +0.242 of the budget at max_dt 1e-4 (was
+/// +0.24–0.26), +0.145 at 1e-2 (was +0.258). What is left is made on the rows against the gate: their symmetric
+/// gradient pushes them into the face every step (the load path to the structure), and the contact takes most of
+/// it back as it stops them.
 #[test]
-#[ignore = "found by this test: the coupled ISPH gate gains 24-26 % of the fluid's energy budget by t = 0.2 s (most \
-            of it in 0.14-0.16 s, when the tip is kicked) and ends ok"]
+#[ignore = "found by this test: the coupled ISPH gate gains 24 % (max_dt 1e-4) and 15 % (1e-2) of the fluid's \
+            energy budget by t = 0.2 s and ends ok"]
 fn isph_elastic_gate_stays_within_the_energy_bound() {
     let budget = budget(&GATE_BLOCKS);
     let releasable = releasable(&GATE_BLOCKS, GATE_FLOOR);

@@ -18,6 +18,10 @@
 //! corrected velocity does not enter it. In ∇·u* the walls carry Δt g (the predictor applied to them) plus the
 //! normal part of the fluid's motion next to them, so the flux into the wall is imposed once, by the Neumann rows.
 //! After the solve negative pressures are clipped to 0 (fluid and walls).
+//!
+//! An interior fluid row whose support the void cuts (no fluid or wall particle there) counts the void as p = 0, as
+//! the corrector's symmetric gradient does ([`ppe::fluid_row`]): otherwise the PPE gives such a particle the
+//! pressure of a closed box and the gradient throws it into the void, creating energy.
 
 use serde::{Deserialize, Serialize};
 pub mod bicgstab;
