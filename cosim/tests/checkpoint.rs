@@ -236,6 +236,15 @@ fn isph_restart_is_byte_identical() {
     assert!(probes(&whole) == probes(&continued), "ISPH restart: probes.csv differs");
 }
 
+/// A copy of the checkpoint folder `ck` at `to`; returns `to`.
+fn copy_of(ck: &Path, to: &Path) -> PathBuf {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(ck).unwrap().flatten() {
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+    to.to_path_buf()
+}
+
 #[test]
 fn a_checkpoint_from_another_scene_or_version_is_refused() {
     let dir = scratch("checkpoint-refused");
@@ -309,11 +318,7 @@ fn a_checkpoint_from_another_scene_or_version_is_refused() {
         &["another scene", "name = \"dam_break\""],
     );
     // Another protocol version.
-    let other = dir.join("other_version");
-    std::fs::create_dir_all(&other).unwrap();
-    for e in std::fs::read_dir(&ck).unwrap().flatten() {
-        std::fs::copy(e.path(), other.join(e.file_name())).unwrap();
-    }
+    let other = copy_of(&ck, &dir.join("other_version"));
     let manifest = other.join("checkpoint.json");
     let text = std::fs::read_to_string(&manifest).unwrap();
     std::fs::write(
@@ -336,11 +341,7 @@ fn a_checkpoint_from_another_scene_or_version_is_refused() {
         &["checkpoint.json", "protocol version 7"],
     );
     // A damaged copy: sph.bin cut short.
-    let damaged = dir.join("damaged");
-    std::fs::create_dir_all(&damaged).unwrap();
-    for e in std::fs::read_dir(&ck).unwrap().flatten() {
-        std::fs::copy(e.path(), damaged.join(e.file_name())).unwrap();
-    }
+    let damaged = copy_of(&ck, &dir.join("damaged"));
     let sph = damaged.join("sph.bin");
     let bytes = std::fs::read(&sph).unwrap();
     std::fs::write(&sph, &bytes[..bytes.len() - 1]).unwrap();

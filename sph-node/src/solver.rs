@@ -525,12 +525,8 @@ impl WcsphSolver {
                 let mut shift = std::mem::take(&mut self.scratch.per2);
                 apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &apd_params, &mut shift);
                 // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
-                let mut drho = std::mem::take(&mut self.scratch.per1);
-                apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
+                self.density_follows_shift(&shift);
                 let s = &mut self.sorted;
-                s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
-                update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-                self.scratch.per1 = drho;
                 integrator::drift(&mut s.x[..nf], &shift, &[], 1.0);
                 self.scratch.per2 = shift;
                 pushes += self.push_out_of_walls();
@@ -607,13 +603,20 @@ impl WcsphSolver {
                 .zip(&s.x[..nf])
                 .map(|(e, x)| [e[0] - x[0], e[1] - x[1]]),
         );
+        self.density_follows_shift(&shift);
+        self.scratch.per2 = shift;
+    }
+
+    /// ρ += δρ for the displacement `shift` of each fluid particle, as the continuity equation would change it
+    /// ([`apd::shift_density_change`]), at the positions and neighbours of the last search; the volumes follow.
+    fn density_follows_shift(&mut self, shift: &[[f64; 2]]) {
+        let nf = self.state.len();
         let mut drho = std::mem::take(&mut self.scratch.per1);
-        apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, &shift, &mut drho);
+        apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, shift, &mut drho);
         let s = &mut self.sorted;
         s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
         self.scratch.per1 = drho;
-        self.scratch.per2 = shift;
     }
 
     /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9)).
