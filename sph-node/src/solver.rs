@@ -214,12 +214,11 @@ impl WcsphSolver {
             apd: spec.apd,
             central_force: 0.0,
         };
-        let mut solver = Self::from_particles(params, options, state, walls)?;
+        // The walls' boxes before the first accelerations: they carry the walls' repulsion (none unless a block
+        // starts within its range).
+        let boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
+        let mut solver = Self::build(params, options, state, walls, boxes)?;
         solver.cfl = spec.cfl;
-        solver.wall_boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
-        // The initial accelerations again, with the walls' repulsion (none unless a block starts within its range).
-        solver.update_pressure_and_acceleration();
-        solver.write_back();
         Ok(solver)
     }
 
@@ -231,6 +230,17 @@ impl WcsphSolver {
         options: WcsphOptions,
         state: FluidState,
         walls: WallParticles,
+    ) -> Result<Self> {
+        Self::build(params, options, state, walls, WallBoxes::default())
+    }
+
+    /// [`WcsphSolver::from_particles`] with the `[[wall]]` boxes of the scene (guard and repulsion).
+    fn build(
+        params: SphParams,
+        options: WcsphOptions,
+        state: FluidState,
+        walls: WallParticles,
+        wall_boxes: WallBoxes,
     ) -> Result<Self> {
         let n = state.len();
         if state.v.len() != n || state.rho.len() != n || state.m.len() != n || state.p.len() != n {
@@ -283,7 +293,7 @@ impl WcsphSolver {
             sorted,
             state_edited: false,
             cfl: 1.0,
-            wall_boxes: WallBoxes::default(),
+            wall_boxes,
             wall_pushes: (0, 0),
             scratch,
         };

@@ -221,8 +221,7 @@ pub fn laplacian_coefficient(m_j: f64, rho_i: f64, rho_j: f64, r: f64, kernel: &
 /// Δt² |G p|² of kinetic energy out only when the PPE's operator is D G), and a particle whose support is cut but
 /// which is not on the free surface by ∇·r (the top of a thin sheet that hits a wall, ∇·r 1.53–1.58 next to the
 /// walls) is given the pressure of a closed box and then thrown out of the sheet by it (the tall dam break at 2× its
-/// step: 19 kPa, particles thrown up at 5 m/s, 9 % of the energy budget created in one step). `full = None` leaves
-/// the row as Shao & Lo 2003 write it.
+/// step: 19 kPa, particles thrown up at 5 m/s, 9 % of the energy budget created in one step).
 #[allow(clippy::too_many_arguments)]
 pub fn fluid_row(
     i: usize,
@@ -232,7 +231,7 @@ pub fn fluid_row(
     free_surface: bool,
     source: f64,
     hydrostatic: Option<([f64; 2], f64)>,
-    full: Option<f64>,
+    full: f64,
 ) -> (Vec<(u32, f64)>, f64) {
     if free_surface {
         // §4.3 step 3: Dirichlet p = 0 on the free surface
@@ -252,7 +251,7 @@ pub fn fluid_row(
             rhs += c * rho0 * (g[0] * r_ij[0] + g[1] * r_ij[1]);
         }
     }
-    if let (None, Some(full)) = (hydrostatic, full) {
+    if hydrostatic.is_none() {
         // The void as p = 0 beyond the tolerance (see above): consistent with the symmetric gradient of the corrector
         diag += (full - diag - VOID_TOLERANCE * full).max(0.0);
     }
@@ -306,7 +305,7 @@ pub fn wall_row(
 /// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` (one per wall particle,
 /// see [`super::wall_normal`]) and the step `dt` in, the matrix and right-hand side out. `view.v` holds u* of the
 /// fluid. `full`: the diagonal of a full support ([`full_support_coefficient`]) for the void rows of
-/// [`fluid_row`]; `None` for none.
+/// [`fluid_row`].
 #[allow(clippy::too_many_arguments)]
 pub fn assemble(
     view: &ParticleView<'_>,
@@ -319,7 +318,7 @@ pub fn assemble(
     sources: &[f64],
     normals: &[[f64; 2]],
     dt: f64,
-    full: Option<f64>,
+    full: f64,
 ) -> (SparseRows, Vec<f64>) {
     let rows: Vec<(Vec<(u32, f64)>, f64)> = (0..view.x.len())
         .into_par_iter()
@@ -369,7 +368,7 @@ mod tests {
             .collect();
         let full = full_support_coefficient(&kernel, dx, rho0);
         let hydro = hydrostatic.then_some(([0.0, -9.81], rho0));
-        let (row, _) = fluid_row(0, &view, &neighbors, &kernel, false, 0.0, hydro, Some(full));
+        let (row, _) = fluid_row(0, &view, &neighbors, &kernel, false, 0.0, hydro, full);
         (row[0].1, full)
     }
 

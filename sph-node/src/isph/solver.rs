@@ -473,11 +473,7 @@ impl IsphSolver {
             dt,
             // The void that cuts a support counts as p = 0 beyond `ppe::VOID_TOLERANCE` of a full support
             // (`ppe::fluid_row`). Computed here, not stored: the checkpoint format stays as it is.
-            Some(ppe::full_support_coefficient(
-                &self.kernel,
-                self.params.dx,
-                self.params.rho0,
-            )),
+            ppe::full_support_coefficient(&self.kernel, self.params.dx, self.params.rho0),
         );
         let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
         let inv_diag: Vec<f64> = a
