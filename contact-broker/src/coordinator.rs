@@ -93,8 +93,17 @@ pub struct Checkpoints {
     pub restart: Option<BrokerState>,
 }
 
+/// What the run's progress callback answers after each step: go on, or stop the run now for the reason given (the
+/// run then ends `failed` with that reason, its outputs so far written, like any other failure).
+pub type Control = std::ops::ControlFlow<String>;
+
 /// Run a scene to its end time (or to the first failure) and write every output.
-pub fn run(scene: &LoadedScene, nodes: Nodes<'_>, info: &RunInfo, progress: &mut dyn FnMut(Progress)) -> Outcome {
+pub fn run(
+    scene: &LoadedScene,
+    nodes: Nodes<'_>,
+    info: &RunInfo,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Outcome {
     run_with(scene, nodes, info, &Checkpoints::default(), progress)
 }
 
@@ -104,7 +113,7 @@ pub fn run_with(
     mut nodes: Nodes<'_>,
     info: &RunInfo,
     plan: &Checkpoints,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> Control,
 ) -> Outcome {
     let started = Instant::now();
     let s = &scene.scene;
@@ -178,7 +187,7 @@ fn drive(
     nodes: &mut Nodes<'_>,
     info: &RunInfo,
     plan: &Checkpoints,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> Control,
     summary: &mut Summary,
     series: &mut Series,
 ) -> anyhow::Result<()> {
@@ -316,7 +325,7 @@ fn drive(
                 next_output += 1;
             }
         }
-        progress(Progress {
+        let control = progress(Progress {
             step,
             t,
             end_time: end,
@@ -324,6 +333,9 @@ fn drive(
             max_penetration: summary.contact_stats.max_penetration,
             exchanged: last_pass.exchanged as u64,
         });
+        if let Control::Break(why) = control {
+            anyhow::bail!("stopped after coupling step {step} (t = {t} s): {why}");
+        }
         // Between two steps: every node answered `step`, its corrections are still to be sent.
         // The last step too, so that a finished run can be continued further.
         if let Some(interval) = plan.interval {

@@ -4,6 +4,7 @@
 //! up, then `{"event":"progress",...}` a few times a second, then `{"event":"done",...}`.
 
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -72,10 +73,12 @@ fn main() {
     }
 }
 
-fn emit(value: serde_json::Value) {
+/// One event line on stdout. An error means nobody reads it any more: a launcher that died (even by SIGKILL, which
+/// runs no clean-up of its own) closes its end of the pipe.
+fn emit(value: serde_json::Value) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
-    let _ = writeln!(out, "{value}");
-    let _ = out.flush();
+    writeln!(out, "{value}")?;
+    out.flush()
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
@@ -146,7 +149,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         s.extra.insert("end_time".into(), scene.scene.run.end_time.into());
         s.extra.insert("endpoints".into(), endpoints.clone().into());
     });
-    emit(serde_json::json!({"event": "listening", "endpoints": endpoints, "run": args.run}));
+    emit(serde_json::json!({"event": "listening", "endpoints": endpoints, "run": args.run}))
+        .context("cannot write the listening event on stdout")?;
 
     let wait = Duration::from_secs_f64(args.wait_nodes);
     let step_timeout = Duration::from_secs_f64(scene.scene.coupling.step_timeout);
@@ -201,8 +205,14 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         if last.elapsed() >= Duration::from_millis(200) || p.t >= p.end_time {
             last = Instant::now();
-            emit(serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time}));
+            let event = serde_json::json!({"event": "progress", "step": p.step, "t": p.t, "end_time": p.end_time});
+            // The launcher (`cosim run`) is gone: nobody will collect this run, so it stops rather than compute
+            // on unwatched (the summary says why; the nodes follow when this broker's liveliness token goes).
+            if let Err(e) = emit(event) {
+                return ControlFlow::Break(format!("the launcher stopped reading this broker's progress ({e})"));
+            }
         }
+        ControlFlow::Continue(())
     };
     let plan = coordinator::Checkpoints {
         interval: args.checkpoint_interval,
@@ -226,7 +236,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             serde_json::to_value(&outcome.summary.timings).unwrap_or_default(),
         );
     });
-    emit(serde_json::json!({"event": "done", "status": outcome.summary.status, "message": outcome.summary.message}));
+    // Nobody may be reading any more (the launcher gone): the summary on disk says the same.
+    let _ = emit(
+        serde_json::json!({"event": "done", "status": outcome.summary.status, "message": outcome.summary.message}),
+    );
     match outcome.error {
         Some(e) => Err(e),
         None => Ok(()),

@@ -213,7 +213,10 @@ fn run_in_process(
         interval: args.checkpoint_interval,
         restart: restart.map(|r| r.broker),
     };
-    let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| bar.update(p));
+    let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| {
+        bar.update(p);
+        std::ops::ControlFlow::Continue(())
+    });
     Ok(outcome.summary)
 }
 

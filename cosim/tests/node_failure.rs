@@ -2,7 +2,8 @@
 //! mid-run — `fem-node`, `sph-node` or `contact-broker` killed with SIGKILL, or `sph-node` frozen with SIGSTOP so
 //! that it stops answering. Each time `cosim run` must exit 1 within seconds with one line on stderr naming the
 //! process and what happened, `summary.json` must say `failed`, the probe samples and frames written before must
-//! still be there, and no process of the run may be left behind.
+//! still be there, and no process of the run may be left behind. And `cosim run` itself killed with SIGKILL: the run
+//! stops and says why in summary.json, and its three processes go with it.
 
 mod common;
 
@@ -47,8 +48,16 @@ fn alive(pid: u32) -> bool {
         .unwrap_or(false)
 }
 
-/// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
-fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
+/// A run of the scene as processes, under way: its `cosim run`, output folder, stderr file and the three children.
+struct Started {
+    run: Kill,
+    out: std::path::PathBuf,
+    stderr_path: std::path::PathBuf,
+    kids: Vec<(u32, String)>,
+}
+
+/// Starts the scene and waits until its three processes run and a few probe samples are written.
+fn start(name: &str) -> Started {
     let dir = scratch(&format!("failure-{name}"));
     let out = dir.join("out");
     let stderr_path = dir.join("stderr.txt");
@@ -69,7 +78,6 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
             .unwrap(),
     );
     let started = Instant::now();
-    // Under way: three children, and a few samples written.
     let kids = loop {
         let kids = children(run.0.id());
         if kids.len() == 3 && samples(&out) >= 3 {
@@ -79,6 +87,36 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
         assert!(started.elapsed() < LIMIT, "the run did not get going: {kids:?}");
         std::thread::sleep(Duration::from_millis(50));
     };
+    Started {
+        run,
+        out,
+        stderr_path,
+        kids,
+    }
+}
+
+/// Waits (at most 10 s) for every process in `kids` to be gone, kills what is left, and fails the test if any was.
+fn assert_all_gone(kids: &[(u32, String)]) {
+    // Nothing is left running (a stopped process counts).
+    let until = Instant::now() + Duration::from_secs(10);
+    while kids.iter().any(|(p, _)| alive(*p)) && Instant::now() < until {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let left: Vec<_> = kids.iter().filter(|(p, _)| alive(*p)).collect();
+    for (p, _) in &left {
+        let _ = Command::new("kill").args(["-9", &p.to_string()]).status();
+    }
+    assert!(left.is_empty(), "left running: {left:?}");
+}
+
+/// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
+fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
+    let Started {
+        mut run,
+        out,
+        stderr_path,
+        kids,
+    } = start(name);
     let (pid, _) = kids
         .iter()
         .find(|(_, n)| n == victim)
@@ -107,16 +145,31 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
     assert!(samples(&out) >= kept, "samples lost: {} < {kept}", samples(&out));
     assert!(summary["samples"].as_u64().unwrap() >= kept as u64, "{summary}");
     assert!(out.join("frames").read_dir().unwrap().count() >= 3);
-    // Nothing is left running (a stopped process counts).
-    let until = Instant::now() + Duration::from_secs(10);
-    while kids.iter().any(|(p, _)| alive(*p)) && Instant::now() < until {
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let left: Vec<_> = kids.iter().filter(|(p, _)| alive(*p)).collect();
-    for (p, _) in &left {
-        let _ = Command::new("kill").args(["-9", &p.to_string()]).status();
-    }
-    assert!(left.is_empty(), "left running: {left:?}");
+    assert_all_gone(&kids);
+}
+
+/// `cosim run` itself killed with SIGKILL (it runs no clean-up): the broker finds its progress pipe closed, stops
+/// the run within a progress interval and writes why in summary.json; the nodes follow it. Nothing may go on
+/// computing a run nobody collects (before, the broker ran on to the scene's end time).
+#[test]
+fn launcher_killed() {
+    let Started { mut run, out, kids, .. } = start("launcher_killed");
+    let kept = samples(&out);
+    let hit = Instant::now();
+    run.0.kill().unwrap();
+    run.0.wait().unwrap();
+    assert_all_gone(&kids);
+    eprintln!(
+        "launcher_killed: its three processes gone {:.2?} after the SIGKILL",
+        hit.elapsed()
+    );
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    let message = summary["message"].as_str().unwrap();
+    assert!(message.contains("the launcher stopped reading"), "{message}");
+    // The end time is 10 s of physics: the run was stopped, not finished.
+    assert!(summary["sim_time"].as_f64().unwrap() < 5.0, "{summary}");
+    assert!(samples(&out) >= kept, "samples lost: {} < {kept}", samples(&out));
 }
 
 #[test]
