@@ -137,11 +137,14 @@ impl Probes {
                 Resolved::Front { component } => sph.map_or(f64::NAN, |(_, s)| {
                     s.x.iter().map(|x| x[component]).fold(f64::NEG_INFINITY, f64::max)
                 }),
+                // A column the water has left holds no height: NaN ("no value", as CSV readers parse it), not the
+                // −inf of an empty maximum. The scene check refuses an x_max left of the water at the start.
                 Resolved::Column { x_max } => sph.map_or(f64::NAN, |(_, s)| {
                     s.x.iter()
                         .filter(|x| x[0] <= x_max)
                         .map(|x| x[1])
-                        .fold(f64::NEG_INFINITY, f64::max)
+                        .reduce(f64::max)
+                        .unwrap_or(f64::NAN)
                 }),
                 Resolved::Pressure { point } => sph.map_or(f64::NAN, |(setup, s)| pressure_at(setup, s, point)),
             })
@@ -229,4 +232,43 @@ fn nearest_node(mesh: &FemMesh, solid: usize, point: [f64; 2]) -> Option<usize> 
             _ => Some((n, d2(p))),
         })
         .map(|(n, _)| n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shipped dam break's column probe (x ≤ 0.01 m) on two snapshots: one with water in the column, one whose
+    /// water has all moved beyond it.
+    #[test]
+    fn an_emptied_column_reads_nan_not_minus_infinity() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
+        let scene = cosim_proto::scene::parse("dam_break.toml", &text, &[]).unwrap();
+        let column = scene
+            .probes
+            .iter()
+            .position(|p| p.kind == ProbeKind::ColumnHeight)
+            .unwrap();
+        let setup = SphSetup {
+            particles: 2,
+            spacing: 0.005,
+            h: 0.0065,
+            density: 1000.0,
+            walls: Vec::new(),
+            dt_stable: 1e-4,
+        };
+        let snap = |x: Vec<[f64; 2]>| SphSnapshot {
+            v: vec![[0.0; 2]; x.len()],
+            rho: vec![1000.0; x.len()],
+            p: vec![0.0; x.len()],
+            m: vec![0.025; x.len()],
+            wall_p: Vec::new(),
+            x,
+        };
+        let mut probes = Probes::resolve(&scene, None, Some(&setup)).unwrap();
+        let full = probes.sample(None, Some((&setup, &snap(vec![[0.0025, 0.0975], [0.2, 0.01]]))));
+        assert_eq!(full[column], 0.0975);
+        let empty = probes.sample(None, Some((&setup, &snap(vec![[0.3, 0.01], [0.2, 0.01]]))));
+        assert!(empty[column].is_nan(), "{}", empty[column]);
+    }
 }

@@ -964,6 +964,25 @@ impl Scene {
                         || key(needed),
                         || format!("missing key ({:?})", probe.kind).to_lowercase(),
                     )?;
+                    if let (ProbeKind::ColumnHeight, Some(x_max), Some(fluid)) = (probe.kind, probe.x_max, &self.fluid)
+                    {
+                        // The first column of particles of a block is half a spacing inside it (sph-node setup).
+                        let first = fluid
+                            .blocks
+                            .iter()
+                            .map(|b| b.min[0] + 0.5 * fluid.spacing)
+                            .fold(f64::INFINITY, f64::min);
+                        check(
+                            x_max >= first,
+                            || key("x_max"),
+                            || {
+                                format!(
+                                    "{x_max} is left of every fluid particle (the first are at x = {first}): the \
+                                     column would be empty from the start"
+                                )
+                            },
+                        )?;
+                    }
                 }
             }
             if let Some(r) = &probe.reference {

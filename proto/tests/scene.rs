@@ -63,6 +63,23 @@ fn errors_name_file_and_key() {
 }
 
 #[test]
+fn a_column_probe_left_of_the_water_is_refused() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
+    let scene = parse("dam_break.toml", &text, &[]).unwrap();
+    let p = scene.probes.iter().position(|p| p.name == "column_height").unwrap();
+    let first = scene.fluid.as_ref().unwrap().blocks[0].min[0] + 0.5 * scene.fluid.as_ref().unwrap().spacing;
+    assert_eq!(
+        err(&text, &[&format!("probe[{p}].x_max=-0.01")]),
+        format!(
+            "f.toml: probe[{p}].x_max: -0.01 is left of every fluid particle (the first are at x = {first}): \
+             the column would be empty from the start"
+        )
+    );
+    // Its first column of particles is inside: accepted.
+    assert!(parse("f.toml", &text, &[format!("probe[{p}].x_max={first}")]).is_ok());
+}
+
+#[test]
 fn resolved_scene_round_trips_through_toml() {
     let s = parse("f.toml", SCENE, &["run.end_time=0.5".into()]).unwrap();
     let again = parse("resolved", &s.to_toml(), &[]).unwrap();
