@@ -85,6 +85,9 @@ pub(crate) struct Detector<'a> {
     pub far_side: f64,
     /// Segments shorter than this are skipped (a collapsed element has no normal).
     pub min_len: f64,
+    /// The largest gap g any caller acts on (the touch gap of the velocity phase; `f64::INFINITY` for every
+    /// contact): [`Detector::detect`] may answer `None` for a master whose gap is certainly above it.
+    pub reach: f64,
 }
 
 impl Detector<'_> {
@@ -107,12 +110,24 @@ impl Detector<'_> {
     /// The contact geometry of particle position `xs` with master `m` when `xs` lies in the master's detection
     /// zone (any gap; the caller tests `g`), else `None`. Same result as [`Detector::attach`] filtered on its flag,
     /// with the cheap rejections (ξ range, corner wedge) done before any square root.
+    ///
+    /// A master whose gap is certainly above [`Detector::reach`] is `None` too, found without a square root: a
+    /// particle among the masters gathered near it is mostly several spacings from all but one or two of them, and
+    /// every caller ignores such a hit (they act on g < 0 or g ≤ reach only), so their results do not change.
     pub fn detect(&self, m: Master, xs: Vec2) -> Option<Hit> {
+        // Twice the largest distance a caller looks at: far above any round-off between this test and `attach`.
+        let far = 2.0 * (self.thickness + self.reach);
         match m {
             Master::Segment(j) => {
                 let s = self.segments[j as usize];
                 let x1 = self.x[s.a];
-                if !(0.0..=1.0).contains(&xi(x1, sub(self.x[s.b], x1), xs)) {
+                let d = sub(self.x[s.b], x1);
+                if !(0.0..=1.0).contains(&xi(x1, d, xs)) {
+                    return None;
+                }
+                // (x_s − x_c)·n · L = (x_s − x1) × d, n = (t_y, −t_x) (`Frame`): beyond `far` on the fluid side.
+                let dn_len = cross(sub(xs, x1), d);
+                if dn_len > 0.0 && dn_len * dn_len > far * far * dot(d, d) {
                     return None;
                 }
             }
@@ -120,6 +135,10 @@ impl Detector<'_> {
                 let k = k as usize;
                 let (p, q) = (self.topo.prev[k], self.topo.next[k]);
                 let r = sub(xs, self.x[k]);
+                // g = |r| − r_c (`attach`): beyond `far` from the node.
+                if dot(r, r) > far * far {
+                    return None;
+                }
                 // ξ_P > 1 ⟺ r·d_P > 0 and ξ_Q < 0 ⟺ r·d_Q < 0 (d the unnormalised segment vectors).
                 if p != NONE && dot(r, self.delta(p)) <= 0.0 || q != NONE && dot(r, self.delta(q)) >= 0.0 {
                     return None;
@@ -252,6 +271,7 @@ mod tests {
             thickness: 0.1,
             far_side: 0.3,
             min_len: 0.0,
+            reach: f64::INFINITY,
         };
         // Below the bottom edge (fluid side), 0.05 away: penetrates the 0.1 thickness by 0.05.
         let h = det.detect(Master::Segment(0), [0.25, -0.05]).unwrap();
@@ -269,6 +289,38 @@ mod tests {
         assert!(det.detect(Master::Node(1), [0.95, -0.05]).is_none());
     }
 
+    proptest::proptest! {
+        /// The early rejection of far masters changes nothing a caller acts on: with a finite `reach` every master
+        /// gives the same hit, to the bit, as without one whenever that hit's gap is at most `reach`, and is `None`
+        /// only where the full detection finds no hit or one beyond `reach`.
+        #[test]
+        fn far_masters_are_dropped_only_beyond_reach(
+            px in -0.6f64..1.6, py in -0.6f64..1.6, reach in 0.0f64..0.2, tilt in -0.3f64..0.3,
+        ) {
+            // A skewed quadrilateral, so that no test point sits on a symmetry line.
+            let x = vec![[0.0, 0.0], [1.0, tilt], [1.0 + tilt, 1.0], [tilt, 1.0 - tilt]];
+            let s: Vec<Segment> = (0..4).map(|i| Segment { a: i, b: (i + 1) % 4 }).collect();
+            let mut topo = Topology::default();
+            topo.build(4, &s);
+            let full = Detector { x: &x, segments: &s, topo: &topo, thickness: 0.1, far_side: 0.3, min_len: 0.0,
+                reach: f64::INFINITY };
+            let near = Detector { reach, ..full };
+            let masters = (0..4u32).flat_map(|i| [Master::Segment(i), Master::Node(i)]);
+            for m in masters {
+                let (a, b) = (full.detect(m, [px, py]), near.detect(m, [px, py]));
+                match (a, b) {
+                    (Some(a), Some(b)) => proptest::prop_assert_eq!(
+                        (a.g.to_bits(), a.n.map(f64::to_bits), a.na.to_bits()),
+                        (b.g.to_bits(), b.n.map(f64::to_bits), b.na.to_bits())
+                    ),
+                    (Some(a), None) => proptest::prop_assert!(a.g > reach, "{m:?}: dropped a hit with g = {}", a.g),
+                    (None, Some(_)) => proptest::prop_assert!(false, "{m:?}: a hit the full detection does not find"),
+                    (None, None) => {}
+                }
+            }
+        }
+    }
+
     #[test]
     fn concave_corner_has_no_node_contact() {
         // Clockwise square = the inside of a tank: every corner concave.
@@ -283,6 +335,7 @@ mod tests {
             thickness: 0.1,
             far_side: 0.3,
             min_len: 0.0,
+            reach: f64::INFINITY,
         };
         assert!(det.attach(Master::Node(0), [0.05, 0.05]).is_none());
         // Both walls act on a particle in the corner.
@@ -306,6 +359,7 @@ mod tests {
             thickness: 0.1,
             far_side: 0.3,
             min_len: 0.0,
+            reach: f64::INFINITY,
         };
         assert!(det.detect(Master::Node(1), [1.05, 0.0]).unwrap().g < 0.0);
         assert!(det.detect(Master::Node(0), [-0.05, 0.0]).unwrap().g < 0.0);

@@ -194,6 +194,7 @@ pub fn particle_element_with(
         r_c,
         d_max,
         min_len,
+        reach: touch,
     };
 
     // ---- Position phase: Gauss–Seidel sweeps (DESIGN.md §4.5 "Position"). ----
@@ -416,6 +417,8 @@ struct Ctx<'a> {
     r_c: f64,
     d_max: f64,
     min_len: f64,
+    /// The touch gap: no caller of `detect` here acts on a larger gap.
+    reach: f64,
 }
 
 impl Ctx<'_> {
@@ -427,6 +430,7 @@ impl Ctx<'_> {
             thickness: self.r_c,
             far_side: self.d_max,
             min_len: self.min_len,
+            reach: self.reach,
         }
     }
 }

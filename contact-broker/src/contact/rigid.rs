@@ -241,6 +241,7 @@ mod tests {
             thickness: 0.1,
             far_side: 0.3,
             min_len: 0.0,
+            reach: f64::INFINITY,
         };
         let masters = [Master::Segment(0), Master::Segment(1), Master::Node(1)];
         let step = position_step(&det, &masters, [0.0, 0.05], 1e-14).unwrap();
