@@ -14,6 +14,7 @@ use contact_broker::checkpoint;
 use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
 use contact_broker::transport::{self, ZenohLink};
+use cosim_bus::interrupt::Interrupt;
 use cosim_bus::status::{serve_status, Board};
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
@@ -95,6 +96,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         None => None,
     };
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    // From here on a signal stops the run between two steps instead of killing the broker mid-step.
+    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let base = args.zenoh_config.as_deref();
     // A bad config file is its own error, not "cannot open a session".
     cosim_bus::session::base_config(base)?;
@@ -185,6 +188,10 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut last = Instant::now();
     let (mut last_t, mut last_step, mut last_wall) = (0.0, 0u64, Instant::now());
     let mut report = |p: Progress| {
+        // Ctrl-C or SIGTERM (`cosim run` passes a Ctrl-C on as SIGTERM): stop here, outputs written.
+        if interrupt.arrived() {
+            return ControlFlow::Break(cosim_bus::interrupt::REASON.to_string());
+        }
         // The broker's own time is not split from its wait for the nodes here: the summary has that split.
         if p.step > last_step {
             let dt = (p.t - last_t) / (p.step - last_step) as f64;

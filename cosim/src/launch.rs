@@ -2,6 +2,7 @@
 //! the broker's progress, and make sure no process outlives the run.
 
 use std::io::{BufRead, BufReader};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
@@ -11,6 +12,8 @@ use anyhow::Context;
 use contact_broker::coordinator::{write_summary, Progress, RunInfo};
 use contact_broker::summary::Summary;
 use cosim_proto::scene::Scene;
+
+use cosim_bus::interrupt::Interrupt;
 
 use crate::cli::{ExternalNode, RunArgs};
 use crate::progress::Bar;
@@ -79,6 +82,10 @@ impl Drop for Guard {
 fn spawn(name: &'static str, program: &Path, args: &[String], log: &Path, stdout: Stdio) -> anyhow::Result<Guard> {
     let log_file = std::fs::File::create(log).with_context(|| format!("cannot create {}", log.display()))?;
     let child = Command::new(program)
+        // Its own process group: a Ctrl-C in the terminal reaches `cosim run` alone, which stops the run through
+        // the broker (SIGTERM, outputs written); the nodes would otherwise die mid-step and the run would read as
+        // a node failure.
+        .process_group(0)
         .args(args)
         .stdin(Stdio::null())
         .stdout(stdout)
@@ -144,6 +151,10 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     std::fs::create_dir_all(&logs)?;
     let broker_log = logs.join("contact-broker.log");
     let started = Instant::now();
+    // Ctrl-C (or SIGTERM) is passed on to the broker as SIGTERM: it stops the run between two steps and writes
+    // the outputs; the nodes follow it. A second Ctrl-C ends `cosim run` at once (the broker then stops as its
+    // progress pipe closes).
+    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
 
     let mut broker_args = vec![
         "--run".into(),
@@ -200,6 +211,11 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         if broker.exited().is_some() {
             anyhow::bail!("contact-broker failed to start: {}", last_line(&broker_log));
         }
+        anyhow::ensure!(
+            !interrupt.arrived(),
+            "{} before the run started",
+            cosim_bus::interrupt::REASON
+        );
         if started.elapsed() > LISTEN_TIMEOUT {
             anyhow::bail!(
                 "contact-broker did not open its session within {} s",
@@ -251,12 +267,28 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
 
     // A node that fails makes the broker fail the run within a step (liveliness); if it does not, stop it.
     let mut node_failed_at: Option<Instant> = None;
+    let mut interrupted_at: Option<Instant> = None;
     let broker_status = loop {
         if let Ok(Event::Progress(p)) = rx.recv_timeout(Duration::from_millis(50)) {
             bar.update(p);
         }
         if let Some(status) = broker.exited() {
             break status;
+        }
+        match interrupted_at {
+            None if interrupt.arrived() => {
+                interrupted_at = Some(Instant::now());
+                let pid = nix::unistd::Pid::from_raw(broker.child.id() as i32);
+                if let Err(e) = nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM) {
+                    tracing::warn!("cannot pass the interrupt on to contact-broker: {e}");
+                }
+            }
+            // A broker that does not stop within a few steps' time (stuck waiting for a node) is stopped.
+            Some(at) if at.elapsed() > GRACE => {
+                let _ = broker.child.kill();
+                break broker.child.wait()?;
+            }
+            _ => {}
         }
         let failed = nodes.iter_mut().any(|n| n.exited().is_some_and(|s| !s.success()));
         match node_failed_at {

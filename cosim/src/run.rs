@@ -1,5 +1,6 @@
 //! `cosim run`: validate the scene, prepare the output folder, run it (processes or in-process), report.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -7,6 +8,7 @@ use anyhow::Context;
 use contact_broker::checkpoint::{self, Restart};
 use contact_broker::coordinator::{self, Checkpoints, Nodes, RunInfo};
 use contact_broker::link::{FemLink, SphLink};
+use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{self, LoadedScene};
 use fem_node::core::FemCore;
@@ -213,9 +215,14 @@ fn run_in_process(
         interval: args.checkpoint_interval,
         restart: restart.map(|r| r.broker),
     };
+    // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once).
+    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| {
         bar.update(p);
-        std::ops::ControlFlow::Continue(())
+        match interrupt.arrived() {
+            true => ControlFlow::Break(cosim_bus::interrupt::REASON.to_string()),
+            false => ControlFlow::Continue(()),
+        }
     });
     Ok(outcome.summary)
 }

@@ -2,8 +2,8 @@
 //! mid-run — `fem-node`, `sph-node` or `contact-broker` killed with SIGKILL, or `sph-node` frozen with SIGSTOP so
 //! that it stops answering. Each time `cosim run` must exit 1 within seconds with one line on stderr naming the
 //! process and what happened, `summary.json` must say `failed`, the probe samples and frames written before must
-//! still be there, and no process of the run may be left behind. And `cosim run` itself killed with SIGKILL: the run
-//! stops and says why in summary.json, and its three processes go with it.
+//! still be there, and no process of the run may be left behind. And `cosim run` itself interrupted (Ctrl-C) or
+//! killed with SIGKILL: the run stops between two steps and says why in summary.json, and its processes go with it.
 
 mod common;
 
@@ -58,6 +58,11 @@ struct Started {
 
 /// Starts the scene and waits until its three processes run and a few probe samples are written.
 fn start(name: &str) -> Started {
+    start_with(name, false)
+}
+
+/// [`start`], or in one process (`--in-process`: no children; it waits for the samples only).
+fn start_with(name: &str, in_process: bool) -> Started {
     let dir = scratch(&format!("failure-{name}"));
     let out = dir.join("out");
     let stderr_path = dir.join("stderr.txt");
@@ -70,6 +75,9 @@ fn start(name: &str) -> Started {
     for s in SETS {
         cmd.args(["--set", s]);
     }
+    if in_process {
+        cmd.arg("--in-process");
+    }
     let mut run = Kill(
         cmd.stdin(Stdio::null())
             .stdout(Stdio::null())
@@ -80,7 +88,7 @@ fn start(name: &str) -> Started {
     let started = Instant::now();
     let kids = loop {
         let kids = children(run.0.id());
-        if kids.len() == 3 && samples(&out) >= 3 {
+        if kids.len() == if in_process { 0 } else { 3 } && samples(&out) >= 3 {
             break kids;
         }
         assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
@@ -146,6 +154,51 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
     assert!(summary["samples"].as_u64().unwrap() >= kept as u64, "{summary}");
     assert!(out.join("frames").read_dir().unwrap().count() >= 3);
     assert_all_gone(&kids);
+}
+
+/// Ctrl-C (SIGINT to `cosim run`), as processes and in-process: the run stops between two steps within a second or
+/// two and keeps what it computed: summary.json `failed` saying it was interrupted, the probe samples, the plots
+/// and the frames so far; exit 1 with one line; no process left. (Before, the broker died mid-run by the same
+/// signal and left no summary and no plots.)
+#[test]
+fn interrupted() {
+    for mode in ["processes", "in-process"] {
+        let name = format!("interrupted_{}", mode.replace('-', "_"));
+        let Started {
+            mut run,
+            out,
+            stderr_path,
+            kids,
+        } = start_with(&name, mode == "in-process");
+        let kept = samples(&out);
+        let hit = Instant::now();
+        let sent = Command::new("kill")
+            .args(["-INT", &run.0.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = wait_exit(&mut run.0, hit + LIMIT, &format!("cosim {mode} after SIGINT"));
+        let took = hit.elapsed();
+        let stderr = std::fs::read_to_string(&stderr_path).unwrap();
+        eprintln!("{name}: cosim exited {took:.2?} after SIGINT: {}", stderr.trim());
+        assert_eq!(status.code(), Some(1), "{stderr}");
+        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
+        assert!(lines[0].contains("interrupted (SIGINT or SIGTERM)"), "{stderr}");
+        assert!(took < Duration::from_secs(10), "{took:?}");
+        let summary = json(&out.join("summary.json"));
+        assert_eq!(summary["status"], "failed", "{summary}");
+        assert_eq!(summary["mode"], mode, "{summary}");
+        assert!(
+            summary["message"].as_str().unwrap().contains("interrupted"),
+            "{summary}"
+        );
+        assert!(samples(&out) >= kept, "samples lost: {} < {kept}", samples(&out));
+        assert!(summary["samples"].as_u64().unwrap() >= kept as u64, "{summary}");
+        assert!(out.join("plots/tip_x.svg").is_file(), "no plot written");
+        assert!(out.join("frames").read_dir().unwrap().count() >= 3);
+        assert_all_gone(&kids);
+    }
 }
 
 /// `cosim run` itself killed with SIGKILL (it runs no clean-up): the broker finds its progress pipe closed, stops
