@@ -120,10 +120,10 @@ pub struct FluidSpec {
     /// XSPH ε; 0 disables.
     #[serde(default = "default_xsph")]
     pub xsph: f64,
-    /// APD β (WCSPH); 0 (the default for now) disables. β ≈ 0.01–0.1 orders a violent flow, but at 0.04 still
-    /// water pairs particles up mid-depth, so it is not on by default yet.
-    #[serde(default)]
-    pub apd: f64,
+    /// APD β (§4.4; 0 disables). Default per solver ([`FluidSpec::apd`]): the paper's 0.04 for WCSPH; 0 for ISPH,
+    /// where the shift is available but not yet the default (docs/CORRECTIONS.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apd: Option<f64>,
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ppe_source: Option<PpeSourceKind>,
@@ -166,7 +166,19 @@ fn is_default_fluid_cfl(cfl: &f64) -> bool {
     *cfl == default_fluid_cfl()
 }
 
+/// APD β of WCSPH when the scene names none: the paper's (Long et al. 2016 after Ozbulut et al. 2013 and Xu et al.
+/// 2009).
+pub const WCSPH_APD_DEFAULT: f64 = 0.04;
+
 impl FluidSpec {
+    /// APD β in force: the scene's, or the per-solver default (WCSPH [`WCSPH_APD_DEFAULT`], ISPH 0).
+    pub fn apd(&self) -> f64 {
+        self.apd.unwrap_or(match self.solver {
+            FluidSolver::Wcsph => WCSPH_APD_DEFAULT,
+            FluidSolver::Isph => 0.0,
+        })
+    }
+
     /// The density filter in force (the per-solver default of §4.4 when the scene names none).
     pub fn density_filter(&self) -> DensityFilter {
         self.density_filter.unwrap_or(match self.solver {
@@ -783,16 +795,11 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Res
         || format!("must be in [0, 1], got {}", f.xsph),
     )?;
     check(
-        f.apd.is_finite() && (0.0..=1.0).contains(&f.apd),
+        f.apd().is_finite() && (0.0..=1.0).contains(&f.apd()),
         || "fluid.apd".into(),
-        || format!("must be in [0, 1], got {}", f.apd),
+        || format!("must be in [0, 1], got {}", f.apd()),
     )?;
     if f.solver == FluidSolver::Isph {
-        check(
-            f.apd == 0.0,
-            || "fluid.apd".into(),
-            || "particle shifting is not implemented for ISPH yet; set 0".into(),
-        )?;
         check(
             f.density_filter() == DensityFilter::None,
             || "fluid.density_filter".into(),

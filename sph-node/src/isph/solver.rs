@@ -7,7 +7,8 @@
 //! 1. predictor u* = uⁿ + Δt (g + ν∇²uⁿ), x* = xⁿ + Δt u*;
 //! 2. neighbours at x*; free surface (∇·r < 1.5 → p = 0); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
 //! 3. PPE solved by Jacobi-BiCGSTAB warm-started from the last pressures (fluid and walls);
-//! 4. corrector u^{n+1} = u* − Δt (∇p/ρ)_i at x*; x^{n+1} = xⁿ + Δt (uⁿ + u^{n+1})/2 (+ Δt XSPH of u^{n+1}).
+//! 4. corrector u^{n+1} = u* − Δt (∇p/ρ)_i at x*; x^{n+1} = xⁿ + Δt (uⁿ + u^{n+1})/2 (+ Δt XSPH of u^{n+1});
+//! 5. APD shift of x^{n+1} (`fluid.apd` > 0, §4.4).
 //!
 //! The fluid is incompressible: ρ = ρ0 for fluid and walls throughout.
 
@@ -19,7 +20,7 @@ use super::contact::{self, ContactLayer, ContactRow};
 use super::wall_guard::WallBoxes;
 use super::{bicgstab, free_surface, ppe, projection, wall_normal, IsphOptions, PpeSource};
 use crate::boundary::walls;
-use crate::corrections::xsph;
+use crate::corrections::{apd, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::kernel::CubicSpline;
@@ -91,6 +92,8 @@ pub struct IsphSolver {
     wall_normals: Vec<[f64; 2]>,
     /// Factor on the step of §4.3 (`fluid.cfl`, in (0, 1]; 1 unless the scene says otherwise).
     cfl: f64,
+    /// APD β (`fluid.apd`, §4.4; 0 disables): the particle shift applied after each step, as for WCSPH.
+    apd: f64,
     scratch: Scratch,
 }
 
@@ -215,6 +218,7 @@ impl IsphSolver {
             wall_boxes,
             wall_normals,
             cfl: spec.cfl,
+            apd: spec.apd(),
             scratch: Scratch::default(),
         };
         solver.contact.record_end(&solver.state);
@@ -574,6 +578,27 @@ impl IsphSolver {
         self.a_max = a_max.max(g[0].hypot(g[1]));
         self.check(step_no)?;
         self.rebuild_neighbors();
+        // 5. APD (§4.4): the shifting of Lind, Xu, Stansby & Rogers (2012), which was made for ISPH, in the same
+        //    δ+-SPH kernel-gradient form and free-surface treatment as WCSPH's (`corrections::apd`), at x^{n+1}.
+        //    The fluid is incompressible (ρ = ρ0): no density to carry along; velocities stay with their particles.
+        if self.apd > 0.0 {
+            let v_max = self.state.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+            if v_max > 0.0 {
+                let params = apd::ApdParams {
+                    beta: self.apd,
+                    v_max,
+                    dt,
+                };
+                let mut shift = Vec::new();
+                apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &params, &mut shift);
+                for (x, d) in self.state.x.iter_mut().zip(&shift) {
+                    x[0] += d[0];
+                    x[1] += d[1];
+                }
+                self.check(step_no)?;
+                self.rebuild_neighbors();
+            }
+        }
         self.state.t += dt;
         self.state.step = step_no;
         self.contact.record_end(&self.state);
