@@ -3,7 +3,7 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use cosim_proto::scene;
+use cosim_proto::scene::{self, DensityFilter};
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -57,6 +57,13 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "fem_substeps_per_step": substeps,
             "frames": frames,
             "probes": s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
+            // The corrections in force (§4.4), the per-solver defaults filled in.
+            "corrections": s.fluid.as_ref().map(|f| serde_json::json!({
+                "density_filter": f.density_filter(),
+                "density_filter_interval": f.density_filter_interval,
+                "xsph": f.xsph,
+                "apd": f.apd(),
+            })),
         });
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(ExitCode::SUCCESS);
@@ -94,6 +101,14 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             (s.run.end_time / dt_fluid).ceil()
         ),
         _ => println!("  fluid: none"),
+    }
+    if let Some(f) = &s.fluid {
+        // The corrections in force (§4.4), the per-solver defaults filled in.
+        let filter = match f.density_filter() {
+            DensityFilter::None => "no density filter".to_string(),
+            other => format!("{other:?} density filter every {} steps", f.density_filter_interval),
+        };
+        println!("  corrections: {filter}, XSPH eps = {}, APD beta = {}", f.xsph, f.apd());
     }
     match (dt_fem, substeps) {
         (Some(d), Some(k)) => println!(

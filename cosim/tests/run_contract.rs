@@ -226,6 +226,35 @@ fn check_prints_what_would_run() {
     assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
 }
 
+/// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
+/// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH only (APD is there but off by default).
+#[test]
+fn check_names_the_corrections_in_force() {
+    let dam = root().join("scenes/dam_break.toml");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", dam.to_str().unwrap(), "--json"];
+        args.extend_from_slice(extra);
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["corrections"].clone()
+    };
+    let wcsph = check(&[]);
+    assert_eq!(wcsph["density_filter"], "shepard", "{wcsph}");
+    assert_eq!(wcsph["density_filter_interval"], 20, "{wcsph}");
+    assert_eq!(wcsph["xsph"], 0.5, "{wcsph}");
+    assert_eq!(wcsph["apd"], 0.04, "{wcsph}");
+    let isph = check(&["--set", "fluid.solver=isph"]);
+    assert_eq!(isph["density_filter"], "none", "{isph}");
+    assert_eq!(isph["apd"], 0.0, "{isph}");
+    assert_eq!(check(&["--set", "fluid.apd=0"])["apd"], 0.0);
+    let csm3 = cosim_run(
+        &["check", root().join("scenes/csm3.toml").to_str().unwrap(), "--json"],
+        Duration::from_secs(30),
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&csm3.stdout).unwrap();
+    assert!(doc["corrections"].is_null(), "a scene without fluid: {doc}");
+}
+
 #[test]
 fn a_blow_up_ends_the_run_unstable_and_keeps_what_was_computed() {
     // A soft bar under a huge load: its elements invert within a few steps.
