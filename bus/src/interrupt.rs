@@ -2,6 +2,7 @@
 //! there with its outputs written (summary, probes, plots, frames so far) instead of dying in the middle of a step.
 //! A second signal ends the process at once (exit code 130), for a run that does not come to its next step.
 
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -26,6 +27,15 @@ impl Interrupt {
     /// Whether a signal arrived.
     pub fn arrived(&self) -> bool {
         self.0.load(Ordering::Relaxed)
+    }
+
+    /// What a run's progress callback answers (`contact_broker::coordinator::Control`): stop with [`REASON`]
+    /// once a signal arrived, else go on.
+    pub fn control(&self) -> ControlFlow<String> {
+        match self.arrived() {
+            true => ControlFlow::Break(REASON.to_string()),
+            false => ControlFlow::Continue(()),
+        }
     }
 }
 

@@ -189,9 +189,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let (mut last_t, mut last_step, mut last_wall) = (0.0, 0u64, Instant::now());
     let mut report = |p: Progress| {
         // Ctrl-C or SIGTERM (`cosim run` passes a Ctrl-C on as SIGTERM): stop here, outputs written.
-        if interrupt.arrived() {
-            return ControlFlow::Break(cosim_bus::interrupt::REASON.to_string());
-        }
+        interrupt.control()?;
         // The broker's own time is not split from its wait for the nodes here: the summary has that split.
         if p.step > last_step {
             let dt = (p.t - last_t) / (p.step - last_step) as f64;

@@ -11,9 +11,8 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use contact_broker::coordinator::{write_summary, Progress, RunInfo};
 use contact_broker::summary::Summary;
-use cosim_proto::scene::Scene;
-
 use cosim_bus::interrupt::Interrupt;
+use cosim_proto::scene::Scene;
 
 use crate::cli::{ExternalNode, RunArgs};
 use crate::progress::Bar;

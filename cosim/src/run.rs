@@ -1,6 +1,5 @@
 //! `cosim run`: validate the scene, prepare the output folder, run it (processes or in-process), report.
 
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -219,10 +218,7 @@ fn run_in_process(
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| {
         bar.update(p);
-        match interrupt.arrived() {
-            true => ControlFlow::Break(cosim_bus::interrupt::REASON.to_string()),
-            false => ControlFlow::Continue(()),
-        }
+        interrupt.control()
     });
     Ok(outcome.summary)
 }

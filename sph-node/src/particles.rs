@@ -1,6 +1,7 @@
 //! Particle data: the serializable [`FluidState`] and [`WallParticles`], and the read-only [`ParticleView`] the
 //! physics functions gather from. Per-step scratch lives in the solver, not here.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::kernel::CubicSpline;
@@ -124,4 +125,24 @@ pub fn separation(xi: [f64; 2], xj: [f64; 2]) -> ([f64; 2], f64) {
 #[inline]
 pub fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
+}
+
+/// max_k |a_k| with |a| = `a[0].hypot(a[1])`, exactly as the maximum over all k, but evaluating `hypot` only for
+/// the vectors whose a[0]² + a[1]² is within 1e-12 (relative; far above its rounding error) of the largest.
+pub(crate) fn max_norm(a: &[[f64; 2]]) -> f64 {
+    let sq = |a: &[f64; 2]| a[0] * a[0] + a[1] * a[1];
+    let largest = a.par_iter().with_min_len(4096).map(sq).reduce(|| 0.0, f64::max);
+    let cut = if largest > 0.0 {
+        largest * (1.0 - 1e-12)
+    } else {
+        f64::NEG_INFINITY
+    };
+    a.par_iter()
+        .with_min_len(4096)
+        .filter(|a| {
+            let s = sq(a);
+            s >= cut || s.is_nan()
+        })
+        .map(|a| a[0].hypot(a[1]))
+        .reduce(|| 0.0, f64::max)
 }

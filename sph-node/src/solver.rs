@@ -27,7 +27,7 @@ use crate::integrator;
 use crate::isph::wall_guard::WallBoxes;
 use crate::kernel::CubicSpline;
 use crate::neighbors::{NeighborList, SortedCells, CHUNK};
-use crate::particles::{separation, FluidState, ParticleView, WallParticles};
+use crate::particles::{max_norm, separation, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::time_step;
 use crate::wcsph::{continuity, momentum, MomentumParams};
@@ -836,26 +836,6 @@ fn xsph_pairs_into(
                 *o = [-eps * s[0], -eps * s[1]];
             }
         });
-}
-
-/// max_k |a_k| with |a| = `a[0].hypot(a[1])`, exactly as the maximum over all k, but evaluating `hypot` only for
-/// the vectors whose a[0]² + a[1]² is within 1e-12 (relative; far above its rounding error) of the largest.
-fn max_norm(a: &[[f64; 2]]) -> f64 {
-    let sq = |a: &[f64; 2]| a[0] * a[0] + a[1] * a[1];
-    let largest = a.par_iter().with_min_len(4096).map(sq).reduce(|| 0.0, f64::max);
-    let cut = if largest > 0.0 {
-        largest * (1.0 - 1e-12)
-    } else {
-        f64::NEG_INFINITY
-    };
-    a.par_iter()
-        .with_min_len(4096)
-        .filter(|a| {
-            let s = sq(a);
-            s >= cut || s.is_nan()
-        })
-        .map(|a| a[0].hypot(a[1]))
-        .reduce(|| 0.0, f64::max)
 }
 
 /// vol = m/ρ.

@@ -25,7 +25,7 @@ use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::kernel::CubicSpline;
 use crate::neighbors::{CellList, NeighborList};
-use crate::particles::{FluidState, ParticleView, WallParticles};
+use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::solver::SphParams;
 
@@ -582,7 +582,7 @@ impl IsphSolver {
         //    δ+-SPH kernel-gradient form and free-surface treatment as WCSPH's (`corrections::apd`), at x^{n+1}.
         //    The fluid is incompressible (ρ = ρ0): no density to carry along; velocities stay with their particles.
         if self.apd > 0.0 {
-            let v_max = self.state.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+            let v_max = max_norm(&self.state.v);
             if v_max > 0.0 {
                 let params = apd::ApdParams {
                     beta: self.apd,
