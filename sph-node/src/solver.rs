@@ -13,6 +13,11 @@
 //! same arithmetic, as the plain gathers of [`continuity`], [`momentum`], [`adami`] and
 //! [`crate::corrections::xsph`] on the id-ordered particles, so the results are bit-identical to theirs (tests
 //! below) and independent of the thread count.
+//!
+//! One search per step: the APD shift (§4.4) is computed at xⁿ with the lists of the last search and applied with
+//! the drift, x^{n+1} = xⁿ + Δt (v^{n+½} + XSPH) + δr (as DualSPHysics applies its shifting with the position
+//! update). Shifting x^{n+1} after the drift, as the solver did before, needed a second search and sort per step:
+//! a sixth of a step's time on the 20,000-particle dam break (docs/PERFORMANCE.md).
 
 use cosim_proto::scene::{BoxSpec, DensityFilter, FluidSolver, Scene};
 use rayon::prelude::*;
@@ -105,8 +110,12 @@ struct Scratch {
     /// One value per particle, for whichever pass needs it at the time (never two at once): the density rate,
     /// the APD density change, the filtered density, the spare of the re-sort.
     per1: Vec<f64>,
-    /// A vector per particle, likewise: the XSPH correction, the APD shift, the spare of the re-sort.
+    /// A vector per particle, likewise: the XSPH correction, the spare of the re-sort.
     per2: Vec<[f64; 2]>,
+    /// The APD shift of each fluid particle (in use with the XSPH correction, for the same drift); empty when the
+    /// step has none. Not kept in a checkpoint: it is computed and used within one step.
+    #[serde(skip)]
+    shift: Vec<[f64; 2]>,
     wall: Vec<(f64, f64)>,
     /// Positions (slot order) edited through `state_mut`, for the next drift; empty when none.
     edited_x: Vec<[f64; 2]>,
@@ -438,6 +447,7 @@ impl WcsphSolver {
             + b(&sc.src)
             + b(&sc.per1)
             + b(&sc.per2)
+            + b(&sc.shift)
             + b(&sc.wall)
             + b(&sc.edited_x)
     }
@@ -512,18 +522,11 @@ impl WcsphSolver {
                 &mut corr,
             );
         }
-        let s = &mut self.sorted;
-        if !self.scratch.edited_x.is_empty() {
-            // Positions edited through `state_mut` since the last step: the drift starts from them.
-            s.x[..nf].copy_from_slice(&self.scratch.edited_x);
-            self.scratch.edited_x.clear();
-        }
-        integrator::drift(&mut s.x[..nf], &s.v[..nf], &corr, dt);
-        self.scratch.per2 = corr;
-        let mut pushes = self.push_out_of_walls();
-        self.check(step_no)?;
-        self.rebuild_neighbors();
-        // APD after the drift (§4.4; Xu et al. 2009, Eq. (35)), then the neighbours of the shifted positions.
+        // APD (§4.4; Xu et al. 2009, Eq. (35)) at x^n, with the neighbours of the last search; the shift joins the
+        // drift below, so that the positions are searched once a step (DualSPHysics applies its shifting with the
+        // position update in the same way).
+        let mut shift = std::mem::take(&mut self.scratch.shift);
+        shift.clear();
         if self.options.apd > 0.0 {
             let v_max = max_norm(&self.sorted.v[..nf]);
             if v_max > 0.0 {
@@ -532,18 +535,33 @@ impl WcsphSolver {
                     v_max,
                     dt,
                 };
-                let mut shift = std::mem::take(&mut self.scratch.per2);
-                apd::apd_into(&self.view(), &self.scratch.list, &self.kernel, &apd_params, &mut shift);
+                apd::apd_pairs_into(
+                    &self.view(),
+                    &self.sorted.vol,
+                    &self.scratch.list,
+                    &self.kernel,
+                    &apd_params,
+                    &mut shift,
+                );
                 // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
                 self.density_follows_shift(&shift);
-                let s = &mut self.sorted;
-                integrator::drift(&mut s.x[..nf], &shift, &[], 1.0);
-                self.scratch.per2 = shift;
-                pushes += self.push_out_of_walls();
-                self.check(step_no)?;
-                self.rebuild_neighbors();
             }
         }
+        let s = &mut self.sorted;
+        if !self.scratch.edited_x.is_empty() {
+            // Positions edited through `state_mut` since the last step: the drift starts from them.
+            s.x[..nf].copy_from_slice(&self.scratch.edited_x);
+            self.scratch.edited_x.clear();
+        }
+        integrator::drift(&mut s.x[..nf], &s.v[..nf], &corr, dt);
+        if !shift.is_empty() {
+            integrator::drift(&mut s.x[..nf], &shift, &[], 1.0);
+        }
+        self.scratch.per2 = corr;
+        self.scratch.shift = shift;
+        let pushes = self.push_out_of_walls();
+        self.check(step_no)?;
+        self.rebuild_neighbors();
         // Rates at the new positions.
         self.density_half_kick(dt);
         if let Some(n) = self.params.shepard_interval {
@@ -622,7 +640,7 @@ impl WcsphSolver {
     fn density_follows_shift(&mut self, shift: &[[f64; 2]]) {
         let nf = self.state.len();
         let mut drho = std::mem::take(&mut self.scratch.per1);
-        apd::shift_density_change_into(&self.view(), &self.scratch.list, &self.kernel, shift, &mut drho);
+        apd::shift_density_change_pairs_into(&self.view(), &self.scratch.list, shift, &mut drho);
         let s = &mut self.sorted;
         s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
@@ -1161,8 +1179,7 @@ mod tests {
                     .map(|i| xsph_correction(i, &view, self.list.of(i), &self.kernel, self.params.xsph))
                     .collect();
             }
-            integrator::drift(&mut self.state.x, &self.state.v, &corr, dt);
-            self.rebuild();
+            let mut shift = Vec::new();
             if self.options.apd > 0.0 {
                 let v_max = self.state.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
                 if v_max > 0.0 {
@@ -1172,15 +1189,17 @@ mod tests {
                         v_max,
                         dt,
                     };
-                    let mut shift = Vec::new();
                     let mut drho = Vec::new();
                     apd::apd_into(&self.view(), &self.list, &self.kernel, &ap, &mut shift);
                     apd::shift_density_change_into(&self.view(), &self.list, &self.kernel, &shift, &mut drho);
                     self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
-                    integrator::drift(&mut self.state.x, &shift, &[], 1.0);
-                    self.rebuild();
                 }
             }
+            integrator::drift(&mut self.state.x, &self.state.v, &corr, dt);
+            if !shift.is_empty() {
+                integrator::drift(&mut self.state.x, &shift, &[], 1.0);
+            }
+            self.rebuild();
             self.continuity(dt);
             if let Some(n) = self.params.shepard_interval {
                 if step_no % u64::from(n.max(1)) == 0 {
