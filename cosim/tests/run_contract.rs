@@ -227,7 +227,7 @@ fn check_prints_what_would_run() {
 }
 
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
-/// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH only (APD is there but off by default).
+/// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]
 fn check_names_the_corrections_in_force() {
     let dam = root().join("scenes/dam_break.toml");
@@ -245,7 +245,7 @@ fn check_names_the_corrections_in_force() {
     assert_eq!(wcsph["apd"], 0.04, "{wcsph}");
     let isph = check(&["--set", "fluid.solver=isph"]);
     assert_eq!(isph["density_filter"], "none", "{isph}");
-    assert_eq!(isph["apd"], 0.0, "{isph}");
+    assert_eq!(isph["apd"], 0.04, "{isph}");
     assert_eq!(check(&["--set", "fluid.apd=0"])["apd"], 0.0);
     let csm3 = cosim_run(
         &["check", root().join("scenes/csm3.toml").to_str().unwrap(), "--json"],

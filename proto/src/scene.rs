@@ -170,12 +170,16 @@ fn is_default_fluid_cfl(cfl: &f64) -> bool {
 /// 2009).
 pub const WCSPH_APD_DEFAULT: f64 = 0.04;
 
+/// APD β of ISPH when the scene names none: the paper's, as for WCSPH.
+pub const ISPH_APD_DEFAULT: f64 = 0.04;
+
 impl FluidSpec {
-    /// APD β in force: the scene's, or the per-solver default (WCSPH [`WCSPH_APD_DEFAULT`], ISPH 0).
+    /// APD β in force: the scene's, or the per-solver default (WCSPH [`WCSPH_APD_DEFAULT`], ISPH
+    /// [`ISPH_APD_DEFAULT`]).
     pub fn apd(&self) -> f64 {
         self.apd.unwrap_or(match self.solver {
             FluidSolver::Wcsph => WCSPH_APD_DEFAULT,
-            FluidSolver::Isph => 0.0,
+            FluidSolver::Isph => ISPH_APD_DEFAULT,
         })
     }
 

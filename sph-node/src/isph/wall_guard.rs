@@ -63,6 +63,28 @@ impl WallBoxes {
         (n > 0.0).then(|| [d[0] / n, d[1] / n])
     }
 
+    /// The displacement `d` of a particle at `x` (outside the walls), with the part that would take it nearer than
+    /// `gap` to a wall box taken off along the box's normal (from its nearest point to `x`), box by box: a particle
+    /// already nearer keeps no motion towards that box; motion along or away from the faces is kept.
+    pub fn hold_off(&self, x: [f64; 2], mut d: [f64; 2], gap: f64) -> [f64; 2] {
+        for (lo, hi) in &self.boxes {
+            let c = [x[0].clamp(lo[0], hi[0]), x[1].clamp(lo[1], hi[1])];
+            let r = [x[0] - c[0], x[1] - c[1]];
+            let dist = r[0].hypot(r[1]);
+            if dist <= 0.0 || dist >= gap + d[0].hypot(d[1]) {
+                continue;
+            }
+            let n = [r[0] / dist, r[1] / dist];
+            let towards = -(d[0] * n[0] + d[1] * n[1]);
+            let allowed = (dist - gap).max(0.0);
+            if towards > allowed {
+                let cut = towards - allowed;
+                d = [d[0] + cut * n[0], d[1] + cut * n[1]];
+            }
+        }
+        d
+    }
+
     /// Moves a particle strictly inside a wall box to the nearest point outside every box whose coordinates are
     /// its own or those of box faces (just outside them: a face, or a corner where boxes meet), and removes the
     /// part of its velocity into the wall along each coordinate that changed. Returns whether it was moved.
@@ -128,6 +150,23 @@ mod tests {
         assert!(w.push_out(&mut x, &mut v));
         assert!((x[0] - 0.2).abs() < 1e-15 && x[1] > 0.0 && x[1] < 1e-8, "{x:?}");
         assert_eq!(v, [2.0, 0.0]);
+    }
+
+    #[test]
+    fn a_shift_stops_at_the_gap_and_keeps_its_tangential_part() {
+        let w = tank();
+        let gap = 0.002;
+        // 3 mm above the floor, shifted 2 mm down and 1 mm along: it stops 2 mm above the floor.
+        let d = w.hold_off([0.2, 0.003], [0.001, -0.002], gap);
+        assert!((d[0] - 0.001).abs() < 1e-15 && (d[1] + 0.001).abs() < 1e-15, "{d:?}");
+        // Already nearer than the gap: no motion towards the floor, away from it unchanged.
+        assert_eq!(w.hold_off([0.2, 0.001], [0.0005, -0.0001], gap), [0.0005, 0.0]);
+        assert_eq!(w.hold_off([0.2, 0.001], [0.0005, 0.0001], gap), [0.0005, 0.0001]);
+        // Far from every box: unchanged.
+        assert_eq!(w.hold_off([0.2, 0.1], [0.0, -0.001], gap), [0.0, -0.001]);
+        // In the corner, against both walls.
+        let d = w.hold_off([0.001, 0.001], [-0.001, -0.001], gap);
+        assert!(d[0].abs() < 1e-18 && d[1].abs() < 1e-18, "{d:?}");
     }
 
     #[test]
