@@ -161,3 +161,61 @@ fn a_blown_up_case_is_a_record_not_an_abort() {
     assert!(report.contains("**unstable**"), "{report}");
     assert_svg(&std::fs::read_to_string(out.join("pareto.svg")).unwrap());
 }
+
+/// `cosim bench` killed with SIGKILL (it runs no clean-up) while a case computes: the case, a `cosim bench-run`
+/// child, gets SIGTERM from the kernel and stops between two steps with its summary written, instead of computing
+/// on to the end of its case (the ISPH dam break at the finest quick spacing takes about 18 s here).
+#[test]
+fn a_killed_bench_takes_its_case_with_it() {
+    let out = scratch("bench_killed").join("bench");
+    let mut cmd = std::process::Command::new(cosim());
+    cmd.current_dir(root())
+        .args(["bench", "--quick", "--only", "dam_break", "--solver", "isph", "--out"])
+        .arg(&out)
+        .env("COSIM_BIN_DIR", bin_dir())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null());
+    let mut bench = Kill(cmd.spawn().unwrap());
+    let until = std::time::Instant::now() + LIMIT;
+    // The third case (the longest): its folder appears when it starts.
+    let case = loop {
+        let kids = children(bench.0.id());
+        let third = std::fs::read_dir(out.join("runs"))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .count()
+            >= 3;
+        if let (Some(&(pid, _)), true) = (kids.first(), third) {
+            break pid;
+        }
+        assert!(
+            std::time::Instant::now() < until,
+            "the bench never started its third case"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    // Past its start-up (where it asks to follow the bench).
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(alive(case), "the case ended before the bench was killed");
+    let hit = std::time::Instant::now();
+    bench.0.kill().unwrap();
+    bench.0.wait().unwrap();
+    while alive(case) && hit.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let gone = !alive(case);
+    if !gone {
+        let _ = std::process::Command::new("kill")
+            .args(["-9", &case.to_string()])
+            .status();
+    }
+    assert!(
+        gone,
+        "the case (pid {case}) kept computing 10 s after the bench was killed"
+    );
+    eprintln!(
+        "a_killed_bench_takes_its_case_with_it: the case gone {:.2?} after the SIGKILL",
+        hit.elapsed()
+    );
+}

@@ -24,30 +24,6 @@ const SETS: [&str; 4] = [
     "run.output_interval=0.005",
 ];
 
-/// The pids and program names of `pid`'s children.
-fn children(pid: u32) -> Vec<(u32, String)> {
-    let mut out = Vec::new();
-    for task in std::fs::read_dir(format!("/proc/{pid}/task"))
-        .into_iter()
-        .flatten()
-        .flatten()
-    {
-        let list = std::fs::read_to_string(task.path().join("children")).unwrap_or_default();
-        for child in list.split_whitespace().filter_map(|c| c.parse::<u32>().ok()) {
-            let name = std::fs::read_to_string(format!("/proc/{child}/comm")).unwrap_or_default();
-            out.push((child, name.trim().to_string()));
-        }
-    }
-    out
-}
-
-/// Whether `pid` is still a live process (not gone, not a zombie).
-fn alive(pid: u32) -> bool {
-    std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .map(|s| s.rsplit_once(") ").is_some_and(|(_, rest)| !rest.starts_with('Z')))
-        .unwrap_or(false)
-}
-
 /// A run of the scene as processes, under way: its `cosim run`, output folder, stderr file and the three children.
 struct Started {
     run: Kill,

@@ -147,11 +147,27 @@ fn command_line() -> String {
 /// `cosim bench-run`: one case of the bench, `cosim run` in this process, then this process's peak resident
 /// memory and CPU time written to `--stats-out` as JSON.
 pub fn bench_run(args: &BenchRunArgs) -> anyhow::Result<ExitCode> {
+    follow_the_bench()?;
     let code = crate::run::run(&args.run)?;
     let stats = serde_json::to_string(&runner::ProcessStats::of_this_process())?;
     let path = &args.stats_out;
     std::fs::write(path, stats + "\n").with_context(|| format!("cannot write {}", path.display()))?;
     Ok(code)
+}
+
+/// A case started by `cosim bench` ends with it: the kernel sends it SIGTERM when the bench goes, however it goes
+/// (SIGKILL included), and the run stops between two steps as on Ctrl-C, with its outputs written (before, a killed
+/// bench left its case computing to the end). A bench already gone before this is set is an error.
+fn follow_the_bench() -> anyhow::Result<()> {
+    let Ok(parent) = std::env::var(runner::PARENT_ENV) else {
+        return Ok(()); // started by hand
+    };
+    #[cfg(target_os = "linux")]
+    nix::sys::prctl::set_pdeathsig(nix::sys::signal::Signal::SIGTERM).context("cannot follow the bench (prctl)")?;
+    if nix::unistd::getppid().as_raw().to_string() != parent {
+        anyhow::bail!("the bench that started this case (pid {parent}) is gone");
+    }
+    Ok(())
 }
 
 /// The 1-minute load average (`/proc/loadavg`): how busy the machine was besides the bench.

@@ -156,6 +156,9 @@ fn spawn_and_wait(case: &Case, out: &Path, limit: Duration) -> Outcome {
     }
 }
 
+/// Environment variable through which the bench gives a case its own pid (see `bench_run`).
+pub const PARENT_ENV: &str = "COSIM_BENCH_PARENT";
+
 fn spawn(case: &Case, out: &Path) -> anyhow::Result<std::process::Child> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     for stale in ["summary.json", STATS_FILE] {
@@ -186,6 +189,8 @@ fn spawn(case: &Case, out: &Path) -> anyhow::Result<std::process::Child> {
     for set in case.sets() {
         cmd.args(["--set", &set]);
     }
+    // The case stops when the bench does (`bench_run`), even when the bench is killed outright.
+    cmd.env(PARENT_ENV, std::process::id().to_string());
     cmd.stdin(Stdio::null())
         .stdout(log.try_clone()?)
         .stderr(log)
