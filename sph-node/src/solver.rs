@@ -25,14 +25,15 @@ use serde::{Deserialize, Serialize};
 
 use crate::boundary::repulsion::Repulsion;
 use crate::boundary::{adami, walls};
+use crate::corrections::xsph::xsph_correction;
 use crate::corrections::{apd, density_filter, mls};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::integrator;
 use crate::isph::wall_guard::WallBoxes;
 use crate::kernel::CubicSpline;
-use crate::neighbors::{NeighborList, SortedCells, CHUNK};
-use crate::particles::{max_norm, separation, FluidState, ParticleView, WallParticles};
+use crate::neighbors::{NeighborList, SortedCells};
+use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::time_step;
 use crate::wcsph::{continuity, momentum, MomentumParams};
@@ -827,33 +828,7 @@ fn xsph_pairs_into(
     eps: f64,
     out: &mut Vec<[f64; 2]>,
 ) {
-    let nf = view.n_fluid;
-    out.resize(nf, [0.0; 2]); // every entry is overwritten
-    out.par_chunks_mut(CHUNK)
-        .zip(list.chunks().par_iter())
-        .for_each(|(out, chunk)| {
-            for (k, o) in out.iter_mut().enumerate() {
-                let i = chunk.first() + k;
-                let (vi, rho_i) = (view.v[i], view.rho[i]);
-                let r = chunk.range(k);
-                let mut s = [0.0, 0.0];
-                let xi = view.x[i];
-                for &j in &chunk.idx[r] {
-                    let j = j as usize;
-                    if j >= nf {
-                        continue;
-                    }
-                    // W(r) with r as `separation` computes it.
-                    let (_, r) = separation(xi, view.x[j]);
-                    let w = kernel.w(r);
-                    // §4.4 XSPH
-                    let f = view.m[j] / (0.5 * (rho_i + view.rho[j])) * w;
-                    s[0] += f * (vi[0] - view.v[j][0]);
-                    s[1] += f * (vi[1] - view.v[j][1]);
-                }
-                *o = [-eps * s[0], -eps * s[1]];
-            }
-        });
+    list.map_pairs_into(out, |i, idx, _| xsph_correction(i, view, idx, kernel, eps));
 }
 
 /// vol = m/ρ.
@@ -883,9 +858,8 @@ fn permute<T: Copy + Default + Send + Sync>(a: &mut Vec<T>, spare: &mut Vec<T>, 
 mod tests {
     use super::*;
     use crate::boundary::adami::wall_pressure;
-    use crate::corrections::xsph::xsph_correction;
-    use crate::corrections::{apd, density_filter, mls};
     use crate::neighbors::CellList;
+    use crate::particles::separation;
     use crate::wcsph::continuity::density_rate;
     use crate::wcsph::momentum::acceleration;
 

@@ -39,7 +39,7 @@
 use rayon::prelude::*;
 
 use crate::kernel::CubicSpline;
-use crate::neighbors::{NeighborList, CHUNK};
+use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
 
 /// ∇·r below which a particle is a free-surface particle (2D).
@@ -201,16 +201,9 @@ pub fn apd_pairs_into(
     params: &ApdParams,
     out: &mut Vec<[f64; 2]>,
 ) {
-    out.resize(view.n_fluid, [0.0; 2]); // every entry is overwritten
-    out.par_chunks_mut(CHUNK)
-        .zip(list.chunks().par_iter())
-        .for_each(|(out, chunk)| {
-            for (k, o) in out.iter_mut().enumerate() {
-                let r = chunk.range(k);
-                let (idx, grad) = (&chunk.idx[r.clone()], &chunk.grad()[r]);
-                *o = apd_shift_pairs(chunk.first() + k, view, vol, idx, grad, kernel, params);
-            }
-        });
+    list.map_pairs_into(out, |i, idx, grad| {
+        apd_shift_pairs(i, view, vol, idx, grad, kernel, params)
+    });
 }
 
 /// Density change of fluid particle i for the shifts `shift` (all fluid particles; walls do not move), at the
@@ -290,14 +283,7 @@ pub fn shift_density_change_pairs_into(
     shift: &[[f64; 2]],
     out: &mut Vec<f64>,
 ) {
-    out.resize(view.n_fluid, 0.0); // every entry is overwritten
-    out.par_chunks_mut(CHUNK)
-        .zip(list.chunks().par_iter())
-        .for_each(|(out, chunk)| {
-            for (k, o) in out.iter_mut().enumerate() {
-                let r = chunk.range(k);
-                *o =
-                    shift_density_change_pairs(chunk.first() + k, view, &chunk.idx[r.clone()], &chunk.grad()[r], shift);
-            }
-        });
+    list.map_pairs_into(out, |i, idx, grad| {
+        shift_density_change_pairs(i, view, idx, grad, shift)
+    });
 }

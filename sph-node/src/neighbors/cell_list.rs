@@ -295,6 +295,27 @@ impl NeighborList {
         });
     }
 
+    /// `out[i] = f(i, neighbours of i, their ∇W factors)` for every particle with a list, in parallel over the
+    /// chunks (each value depends on its own particle only, so the result does not depend on the thread count).
+    /// The factors are empty when the builder did not evaluate the kernel.
+    pub fn map_pairs_into<T, F>(&self, out: &mut Vec<T>, f: F)
+    where
+        T: Copy + Default + Send,
+        F: Fn(usize, &[u32], &[f64]) -> T + Sync,
+    {
+        out.resize(self.n, T::default()); // every entry is overwritten
+        out.par_chunks_mut(CHUNK)
+            .zip(self.chunks.par_iter())
+            .for_each(|(out, chunk)| {
+                let grad = chunk.grad();
+                for (k, o) in out.iter_mut().enumerate() {
+                    let r = chunk.range(k);
+                    let g = if grad.is_empty() { &[][..] } else { &grad[r.clone()] };
+                    *o = f(chunk.first() + k, &chunk.idx[r], g);
+                }
+            });
+    }
+
     /// Neighbours of particle i.
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {

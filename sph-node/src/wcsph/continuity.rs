@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use crate::kernel::CubicSpline;
-use crate::neighbors::{NeighborList, CHUNK};
+use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
 
 /// Dρ_i/Dt of fluid particle i (wall neighbours included, with their zero velocity).
@@ -51,13 +51,5 @@ pub fn density_rate_pairs(i: usize, view: &ParticleView<'_>, vol: &[f64], neighb
 /// Dρ/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j.
 pub fn density_rates_pairs_into(view: &ParticleView<'_>, vol: &[f64], list: &NeighborList, out: &mut Vec<f64>) {
-    out.resize(view.n_fluid, 0.0); // every entry is overwritten
-    out.par_chunks_mut(CHUNK)
-        .zip(list.chunks().par_iter())
-        .for_each(|(out, chunk)| {
-            for (k, o) in out.iter_mut().enumerate() {
-                let r = chunk.range(k);
-                *o = density_rate_pairs(chunk.first() + k, view, vol, &chunk.idx[r.clone()], &chunk.grad()[r]);
-            }
-        });
+    list.map_pairs_into(out, |i, idx, grad| density_rate_pairs(i, view, vol, idx, grad));
 }

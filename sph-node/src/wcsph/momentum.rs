@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use crate::kernel::CubicSpline;
-use crate::neighbors::{NeighborList, CHUNK};
+use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
 use crate::wcsph::artificial_viscosity::pi_ij;
 use crate::wcsph::laminar_viscosity::morris_factor;
@@ -171,17 +171,7 @@ pub fn accelerations_pairs_into(
     out: &mut Vec<[f64; 2]>,
 ) {
     let h = kernel.h();
-    out.resize(view.n_fluid, [0.0; 2]); // every entry is overwritten
-    out.par_chunks_mut(CHUNK)
-        .zip(list.chunks().par_iter())
-        .for_each(|(out, chunk)| {
-            for (k, o) in out.iter_mut().enumerate() {
-                let r = chunk.range(k);
-                let pairs = Pairs {
-                    idx: &chunk.idx[r.clone()],
-                    grad: &chunk.grad()[r],
-                };
-                *o = acceleration_pairs(chunk.first() + k, view, pr2, pairs, h, params);
-            }
-        });
+    list.map_pairs_into(out, |i, idx, grad| {
+        acceleration_pairs(i, view, pr2, Pairs { idx, grad }, h, params)
+    });
 }
