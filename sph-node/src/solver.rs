@@ -25,8 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::boundary::repulsion::Repulsion;
 use crate::boundary::{adami, walls};
-use crate::corrections::xsph::xsph_correction;
-use crate::corrections::{apd, density_filter, mls};
+use crate::corrections::{apd, density_filter, mls, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::integrator;
@@ -515,7 +514,7 @@ impl WcsphSolver {
         let mut corr = std::mem::take(&mut self.scratch.per2);
         corr.clear();
         if self.params.xsph > 0.0 {
-            xsph_pairs_into(
+            xsph::xsph_into(
                 &self.view(),
                 &self.scratch.list,
                 &self.kernel,
@@ -819,18 +818,6 @@ impl WcsphSolver {
     }
 }
 
-/// [`crate::corrections::xsph::xsph_correction`] of every fluid particle into `out`, over the neighbours of the
-/// lists: the same sum, bit for bit (checked by the tests below).
-fn xsph_pairs_into(
-    view: &ParticleView<'_>,
-    list: &NeighborList,
-    kernel: &CubicSpline,
-    eps: f64,
-    out: &mut Vec<[f64; 2]>,
-) {
-    list.map_pairs_into(out, |i, idx, _| xsph_correction(i, view, idx, kernel, eps));
-}
-
 /// vol = m/ρ.
 fn update_vol(vol: &mut [f64], m: &[f64], rho: &[f64]) {
     vol.par_iter_mut()
@@ -858,6 +845,7 @@ fn permute<T: Copy + Default + Send + Sync>(a: &mut Vec<T>, spare: &mut Vec<T>, 
 mod tests {
     use super::*;
     use crate::boundary::adami::wall_pressure;
+    use crate::corrections::xsph::xsph_correction;
     use crate::neighbors::CellList;
     use crate::particles::separation;
     use crate::wcsph::continuity::density_rate;
@@ -923,7 +911,7 @@ mod tests {
             .collect();
         assert_eq!(bits(&accel), bits(&expected));
         let mut xsph = Vec::new();
-        xsph_pairs_into(&view, list, &kernel, 0.5, &mut xsph);
+        xsph::xsph_into(&view, list, &kernel, 0.5, &mut xsph);
         let expected: Vec<_> = (0..nf)
             .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
             .collect();
