@@ -9,8 +9,9 @@
 //! Environment: `SPH_BENCH_SPACINGS` (comma-separated Δx, default `0.001,0.0005`), `SPH_BENCH_THREADS` (default
 //! `1,2`), `SPH_BENCH_STEPS` (steps per repetition, default 20), `SPH_BENCH_REPS` (default 5).
 //! `SPH_BENCH_SOLVER=isph` measures the ISPH solver on the same scene instead (steps default 3, repetitions 3: a
-//! step solves a PPE; the neighbour and heap columns are not counted for ISPH and print 0; the PPE iterations of
-//! the last step are printed after the row).
+//! step solves a PPE; its neighbour column counts the wall particles' lists too, per fluid particle, and its heap
+//! column is the peak of the heap in use from building the solver through its first two steps, temporaries
+//! included, from the counting allocator; the PPE iterations of the last step are printed after the row).
 //! `SPH_BENCH_SET` (scene overrides separated by `;`, e.g. `fluid.kinematic_viscosity=1e-6;fluid.xsph=0`) measures a
 //! variant of the scene: what a switched-off term saves (the laminar viscosity loop is skipped at ν = 0, XSPH at
 //! ε = 0, the density filter at `none`).
@@ -21,7 +22,13 @@
 use std::process::Command;
 use std::time::Instant;
 
+use peak_alloc::PeakAlloc;
 use sph_node::{IsphSolver, WcsphSolver};
+
+/// Counts the heap in use and its peak: ISPH allocates its matrix and Krylov vectors inside the step, which a count
+/// of the solver's own arrays (WCSPH's `heap_bytes`) would not see.
+#[global_allocator]
+static HEAP: PeakAlloc = PeakAlloc;
 
 fn scene(spacing: f64, extra: &[&str]) -> cosim_proto::scene::Scene {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
@@ -74,6 +81,8 @@ fn run_size_isph(spacing: f64) {
     let steps = env_usize("SPH_BENCH_STEPS", 3);
     let reps = env_usize("SPH_BENCH_REPS", 3);
     let before = peak_rss();
+    let heap_before = HEAP.current_usage();
+    HEAP.reset_peak_usage();
     let mut solver = IsphSolver::new(&scene(spacing, &["fluid.solver=\"isph\""])).unwrap();
     let n = solver.state().len();
     let walls = solver.walls().x.len();
@@ -82,18 +91,19 @@ fn run_size_isph(spacing: f64) {
         solver.step(dt).unwrap();
     }
     let rss = peak_rss().saturating_sub(before) as f64 / n as f64;
+    // Peak heap of the solver and its first two steps (lists, matrix, Krylov vectors and all temporaries).
+    let heap = HEAP.peak_usage().saturating_sub(heap_before) as f64 / n as f64;
     for t in threads {
         let (rates, cpu_rates, lo, hi) = measure(t, n, steps, reps, || {
             let dt = solver.stable_dt();
             solver.step(dt).unwrap();
         });
         println!(
-            "{n:>9} {walls:>7} {t:>7} {:>14.3e} {:>19} {:>12.3e} {:>10.1} {:>10.0} B {rss:>8.0} B  (ISPH, PPE {} it.)",
+            "{n:>9} {walls:>7} {t:>7} {:>14.3e} {:>19} {:>12.3e} {:>10.1} {heap:>10.0} B {rss:>8.0} B  (ISPH, PPE {} it.)",
             rates,
             format!("{lo:.2e}–{hi:.2e}"),
             cpu_rates,
-            0.0,
-            0.0,
+            solver.pair_count() as f64 / n as f64,
             solver.last_ppe().iterations,
         );
     }

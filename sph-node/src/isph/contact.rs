@@ -144,17 +144,24 @@ impl ContactLayer {
     /// It is against that face while it was corrected within [`STEPS_KEPT`] steps and lies within Δx of it.
     pub fn detect(&mut self, state: &FluidState, dx: f64) {
         let n = state.len();
-        if self.x_end.len() != n || self.age.len() != n {
+        self.corrected = 0;
+        if self.x_end.len() != n {
+            return; // first step: nothing to compare with
+        }
+        if self.age.len() != n {
+            // The per-particle records are made at the first correction: a run that is never corrected (no
+            // structure) does not hold them. Before it every particle is as they would have recorded it: never
+            // corrected, against no face.
+            let changed = |i: usize| state.x[i] != self.x_end[i] || state.v[i] != self.v_end[i];
+            if !(0..n).any(changed) {
+                return;
+            }
             self.face = vec![Face::default(); n];
             self.point = vec![[0.0; 2]; n];
             self.time = vec![0.0; n];
             self.measured = vec![false; n];
             self.age = vec![u32::MAX; n];
             self.flags = vec![false; n];
-            self.corrected = 0;
-            if self.x_end.len() != n {
-                return; // first step: nothing to compare with
-            }
         }
         let r_c = 0.5 * dx;
         let mut corrected = 0;
@@ -232,7 +239,7 @@ impl ContactLayer {
 /// the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
 /// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its free-surface flag
 /// becomes ∇·r (in front of the face plus the half-space) < `threshold`. Distances below −Δx/4 (a particle the
-/// predictor took into the structure) count as −Δx/4.
+/// predictor took into the structure) count as −Δx/4. `out` is left empty when no particle is against a face.
 #[allow(clippy::too_many_arguments)]
 pub fn contact_rows_into(
     view: &ParticleView<'_>,
@@ -248,7 +255,7 @@ pub fn contact_rows_into(
     out.clear();
     let nf = view.n_fluid;
     if !layer.any() {
-        out.resize(nf, None);
+        // Nothing in contact: no row at all (an uncoupled run does not hold a row per particle).
         return;
     }
     (0..nf)
@@ -315,5 +322,35 @@ mod tests {
         assert!((w_sum - 0.237).abs() < 0.01, "{w_sum}");
         let (far, _) = half_space(&kernel, dx, 2.0 * dx);
         assert!(far < 0.01 && far < div_r, "{far}");
+    }
+
+    #[test]
+    fn a_layer_never_corrected_holds_no_records_and_the_first_correction_makes_them() {
+        let dx = 0.01;
+        let mut state = FluidState {
+            t: 0.0,
+            step: 0,
+            x: vec![[0.0, 0.0], [dx, 0.0], [2.0 * dx, 0.0]],
+            v: vec![[0.0; 2]; 3],
+            rho: vec![1000.0; 3],
+            p: vec![0.0; 3],
+            m: vec![0.1; 3],
+        };
+        let mut layer = ContactLayer::default();
+        for _ in 0..3 {
+            layer.detect(&state, dx);
+            layer.record_end(&state);
+            state.t += 1e-3;
+        }
+        assert!(!layer.any() && layer.face(1).is_none() && layer.corrected() == 0);
+        assert_eq!(layer.age.len() + layer.face.len() + layer.flags.len(), 0, "records held before any correction");
+        // The contact puts particle 1 back along +y by 1e-4 m: it is against a face with normal +y, Δx/2 below it.
+        state.x[1][1] += 1e-4;
+        layer.detect(&state, dx);
+        assert_eq!((layer.corrected(), layer.age.len()), (1, 3));
+        let face = layer.face(1).expect("particle 1 against a face");
+        assert_eq!(face.normal, [0.0, 1.0]);
+        assert!((face.distance(state.x[1]) - 0.5 * dx).abs() < 1e-15, "{}", face.distance(state.x[1]));
+        assert!(layer.face(0).is_none() && layer.face(2).is_none());
     }
 }

@@ -30,6 +30,7 @@ pub mod free_surface;
 pub mod ppe;
 pub mod projection;
 pub mod solver;
+pub mod sparse;
 pub mod wall_guard;
 pub mod wall_normal;
 

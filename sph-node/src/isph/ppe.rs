@@ -15,82 +15,12 @@
 //!   projection's condition u^{n+1} · n = 0 ([`super::wall_normal`]); a wall particle with no fluid in reach gets
 //!   p_w = 0.
 
-use rayon::prelude::*;
-
+use super::sparse::RowSink;
+pub use super::sparse::SparseRows;
 use super::wall_normal;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{separation, ParticleView};
-
-/// A square sparse matrix in compressed rows; each row's entries are in the fixed order they were assembled
-/// (the diagonal first), so products are bit-identical for any thread count.
-#[derive(Clone, Debug, Default)]
-pub struct SparseRows {
-    start: Vec<usize>,
-    col: Vec<u32>,
-    val: Vec<f64>,
-}
-
-impl SparseRows {
-    /// Rows from per-row (column, value) lists, in order.
-    pub fn from_rows(rows: &[Vec<(u32, f64)>]) -> Self {
-        let mut m = Self::default();
-        m.start.reserve(rows.len() + 1);
-        m.start.push(0);
-        for row in rows {
-            for &(c, v) in row {
-                m.col.push(c);
-                m.val.push(v);
-            }
-            m.start.push(m.col.len());
-        }
-        m
-    }
-
-    /// Number of rows.
-    pub fn n(&self) -> usize {
-        self.start.len().saturating_sub(1)
-    }
-
-    /// Stored entries.
-    pub fn nnz(&self) -> usize {
-        self.val.len()
-    }
-
-    /// (columns, values) of row i.
-    #[inline]
-    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
-        let r = self.start[i]..self.start[i + 1];
-        (&self.col[r.clone()], &self.val[r])
-    }
-
-    /// The diagonal (0 where a row has no diagonal entry).
-    pub fn diagonal(&self) -> Vec<f64> {
-        (0..self.n())
-            .into_par_iter()
-            .map(|i| {
-                let (c, v) = self.row(i);
-                c.iter().zip(v).filter(|(&c, _)| c as usize == i).map(|(_, &v)| v).sum()
-            })
-            .collect()
-    }
-
-    /// Replaces row i by the Dirichlet row p_i = 0 in place (the diagonal becomes 1, the other entries 0; the
-    /// caller sets the right-hand side to 0).
-    pub fn set_dirichlet(&mut self, i: usize) {
-        for k in self.start[i]..self.start[i + 1] {
-            self.val[k] = if self.col[k] as usize == i { 1.0 } else { 0.0 };
-        }
-    }
-
-    /// y = A x (a gather per row).
-    pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
-        y.par_iter_mut().enumerate().for_each(|(i, yi)| {
-            let (c, v) = self.row(i);
-            *yi = c.iter().zip(v).map(|(&c, &v)| v * x[c as usize]).sum();
-        });
-    }
-}
 
 /// Makes the system nonsingular: every unknown must reach a Dirichlet row (p = 0: a free-surface particle, or a
 /// wall particle with no fluid in reach) through the nonzero entries of its row. A group of rows that does not
@@ -232,21 +162,22 @@ pub fn fluid_row(
     source: f64,
     hydrostatic: Option<([f64; 2], f64)>,
     full: f64,
-) -> (Vec<(u32, f64)>, f64) {
+    row: &mut RowSink<'_>,
+) -> f64 {
     if free_surface {
         // §4.3 step 3: Dirichlet p = 0 on the free surface
-        return (vec![(i as u32, 1.0)], 0.0);
+        row.push(i as u32, 1.0);
+        return 0.0;
     }
     let (xi, rho_i) = (view.x[i], view.rho[i]);
-    let mut row = Vec::with_capacity(neighbors.len() + 1);
-    row.push((i as u32, 0.0));
+    row.push(i as u32, 0.0);
     let mut diag = 0.0;
     let mut rhs = -source;
     for &j in neighbors {
         let (r_ij, r) = separation(xi, view.x[j as usize]);
         let c = laplacian_coefficient(view.m[j as usize], rho_i, view.rho[j as usize], r, kernel);
         diag += c;
-        row.push((j, -c));
+        row.push(j, -c);
         if let Some((g, rho0)) = hydrostatic {
             rhs += c * rho0 * (g[0] * r_ij[0] + g[1] * r_ij[1]);
         }
@@ -255,8 +186,8 @@ pub fn fluid_row(
         // The void as p = 0 beyond the tolerance (see above): consistent with the symmetric gradient of the corrector
         diag += (full - diag - VOID_TOLERANCE * full).max(0.0);
     }
-    row[0].1 = diag;
-    (row, rhs)
+    row.values_mut()[0] = diag;
+    rhs
 }
 
 /// Row of wall particle w (a `view` index ≥ `n_fluid`) and its right-hand side: Adami et al. 2012, Eq. (27), with
@@ -271,9 +202,10 @@ pub fn wall_row(
     gravity: [f64; 2],
     normal: [f64; 2],
     dt: f64,
-) -> (Vec<(u32, f64)>, f64) {
+    row: &mut RowSink<'_>,
+) -> f64 {
     let xw = view.x[w];
-    let mut row = vec![(w as u32, 1.0)];
+    row.push(w as u32, 1.0);
     let (mut sum_w, mut sum_rho_r, mut sum_motion) = (0.0, [0.0, 0.0], 0.0);
     for &f in neighbors {
         let f = f as usize;
@@ -286,26 +218,27 @@ pub fn wall_row(
         sum_rho_r[0] += view.rho[f] * r_wf[0] * wgt;
         sum_rho_r[1] += view.rho[f] * r_wf[1] * wgt;
         sum_motion += wall_normal::normal_motion_term(view.rho[f], view.v[f], r_wf, normal, dt, gravity) * wgt;
-        row.push((f as u32, wgt));
+        row.push(f as u32, wgt);
     }
     if sum_w <= 0.0 {
-        return (vec![(w as u32, 1.0)], 0.0);
+        row.clear();
+        row.push(w as u32, 1.0);
+        return 0.0;
     }
-    for e in &mut row[1..] {
+    for e in &mut row.values_mut()[1..] {
         // Adami et al. 2012, Eq. (27): p_w = Σ_f p_f W_wf / Σ_f W_wf + …
-        e.1 = -e.1 / sum_w;
+        *e = -*e / sum_w;
     }
     // Adami et al. 2012, Eq. (27), a_w = 0: … + g · Σ_f ρ_f r_wf W_wf / Σ_f W_wf; + the normal motion stopped by the
     // projection (Cummins & Rudman 1999: ∂p/∂n = ρ u*·n/Δt), `wall_normal`
-    let rhs = (gravity[0] * sum_rho_r[0] + gravity[1] * sum_rho_r[1] + sum_motion) / sum_w;
-    (row, rhs)
+    (gravity[0] * sum_rho_r[0] + gravity[1] * sum_rho_r[1] + sum_motion) / sum_w
 }
 
 /// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags), `contact`
 /// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` (one per wall particle,
-/// see [`super::wall_normal`]) and the step `dt` in, the matrix and right-hand side out. `view.v` holds u* of the
+/// see [`super::wall_normal`]) and the step `dt` in. `view.v` holds u* of the
 /// fluid. `full`: the diagonal of a full support ([`full_support_coefficient`]) for the void rows of
-/// [`fluid_row`].
+/// [`fluid_row`]. The matrix goes into `a` and the right-hand side into `b`, reusing their allocations.
 #[allow(clippy::too_many_arguments)]
 pub fn assemble(
     view: &ParticleView<'_>,
@@ -319,22 +252,26 @@ pub fn assemble(
     normals: &[[f64; 2]],
     dt: f64,
     full: f64,
-) -> (SparseRows, Vec<f64>) {
-    let rows: Vec<(Vec<(u32, f64)>, f64)> = (0..view.x.len())
-        .into_par_iter()
-        .map(|i| {
-            if i < view.n_fluid {
-                let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
-                fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic, full)
-            } else {
-                let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
-                wall_row(i, view, list.of(i), kernel, gravity, normal, dt)
-            }
-        })
-        .collect();
-    let b = rows.iter().map(|r| r.1).collect();
-    let rows: Vec<Vec<(u32, f64)>> = rows.into_iter().map(|r| r.0).collect();
-    (SparseRows::from_rows(&rows), b)
+    a: &mut SparseRows,
+    b: &mut Vec<f64>,
+) {
+    let nf = view.n_fluid;
+    // Entries per row at most: a free-surface row has 1; a fluid row the particle and its neighbours; a wall row the
+    // wall particle and its fluid neighbours.
+    let bound = |i: usize| match i < nf {
+        true if free[i] => 1,
+        true => 1 + list.of(i).len(),
+        false => 1 + list.of(i).iter().filter(|&&j| (j as usize) < nf).count(),
+    };
+    a.assemble(view.x.len(), b, bound, |i, row| {
+        if i < view.n_fluid {
+            let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
+            fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic, full, row)
+        } else {
+            let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
+            wall_row(i, view, list.of(i), kernel, gravity, normal, dt, row)
+        }
+    });
 }
 
 #[cfg(test)]
@@ -368,8 +305,14 @@ mod tests {
             .collect();
         let full = full_support_coefficient(&kernel, dx, rho0);
         let hydro = hydrostatic.then_some(([0.0, -9.81], rho0));
-        let (row, _) = fluid_row(0, &view, &neighbors, &kernel, false, 0.0, hydro, full);
-        (row[0].1, full)
+        let mut a = SparseRows::default();
+        a.assemble(
+            1,
+            &mut Vec::new(),
+            |_| neighbors.len() + 1,
+            |_, row| fluid_row(0, &view, &neighbors, &kernel, false, 0.0, hydro, full, row),
+        );
+        (a.row(0).1[0], full)
     }
 
     #[test]

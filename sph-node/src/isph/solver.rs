@@ -46,6 +46,12 @@ struct Scratch {
     source: Vec<f64>,
     xsph: Vec<[f64; 2]>,
     wall_v: Vec<[f64; 2]>,
+    /// The PPE's matrix and right-hand side, assembled anew each step into the allocations of the last (not
+    /// saved: a checkpoint's format does not change).
+    #[serde(skip)]
+    ppe: ppe::SparseRows,
+    #[serde(skip)]
+    rhs: Vec<f64>,
 }
 
 /// What the last PPE solve did.
@@ -262,6 +268,12 @@ impl IsphSolver {
         &self.walls
     }
 
+    /// Neighbour pairs of the current lists (ordered: each pair counts once for each of its particles), the wall
+    /// particles' lists included (their PPE rows need them).
+    pub fn pair_count(&self) -> usize {
+        self.scratch.list.pair_count()
+    }
+
     /// Iterations, residual and free-surface count of the last PPE solve.
     pub fn last_ppe(&self) -> PpeReport {
         self.last_ppe
@@ -350,20 +362,20 @@ impl IsphSolver {
                 .map(|i| projection::viscous_acceleration(i, &view, list.of(i), kernel, nu))
                 .collect()
         };
-        let mut v_star = v_n.clone();
-        for (v, a) in v_star.iter_mut().zip(&visc) {
+        // u* in place of uⁿ (kept in `v_n`).
+        for (v, a) in self.state.v.iter_mut().zip(&visc) {
             v[0] += dt * (g[0] + a[0]);
             v[1] += dt * (g[1] + a[1]);
         }
+        drop(visc);
         // x* = xⁿ + Δt u*
-        for (x, v) in self.state.x.iter_mut().zip(&v_star) {
+        for (x, v) in self.state.x.iter_mut().zip(&self.state.v) {
             x[0] += dt * v[0];
             x[1] += dt * v[1];
         }
-        self.state.v.copy_from_slice(&v_star);
         self.check(step_no)?;
         self.rebuild_neighbors();
-        self.scratch.v[..nf].copy_from_slice(&v_star);
+        self.scratch.v[..nf].copy_from_slice(&self.state.v);
 
         // 2. Free surface and PPE source at x*.
         let mut free = std::mem::take(&mut self.scratch.free);
@@ -429,7 +441,7 @@ impl IsphSolver {
             // ρ* of a particle against a structure counts the structure's half-space as fluid.
             let rows = &rows;
             let rho_star = |i: usize| {
-                let s = match rows[i] {
+                let s = match rows.get(i).copied().flatten() {
                     Some(row) => row.density,
                     None => projection::summation_density(i, &view, list.of(i), kernel),
                 };
@@ -465,7 +477,11 @@ impl IsphSolver {
             *v = [0.0, 0.0];
         }
         // 3. PPE (Shao & Lo 2003, Eq. (15); walls: Adami et al. 2012, Eq. (27)), warm-started.
-        let (mut a, mut b) = ppe::assemble(
+        let (mut a, mut b) = (
+            std::mem::take(&mut self.scratch.ppe),
+            std::mem::take(&mut self.scratch.rhs),
+        );
+        ppe::assemble(
             &self.view(),
             &self.scratch.list,
             &self.kernel,
@@ -479,6 +495,8 @@ impl IsphSolver {
             // The void that cuts a support counts as p = 0 beyond `ppe::VOID_TOLERANCE` of a full support
             // (`ppe::fluid_row`). Computed here, not stored: the checkpoint format stays as it is.
             ppe::full_support_coefficient(&self.kernel, self.params.dx, self.params.rho0),
+            &mut a,
+            &mut b,
         );
         let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
         let inv_diag: Vec<f64> = a
@@ -505,6 +523,7 @@ impl IsphSolver {
         self.scratch.source = source;
         self.scratch.contact = rows;
         self.scratch.in_contact = in_contact;
+        (self.scratch.ppe, self.scratch.rhs) = (a, b);
         let stats = match result {
             Ok(s) => s,
             Err(s) => {
@@ -622,7 +641,8 @@ impl IsphSolver {
         s.x.extend_from_slice(&self.state.x);
         s.x.extend_from_slice(&self.walls.x);
         s.cells.rebuild(&s.x, self.kernel.support());
-        s.list = s.cells.neighbor_list(&s.x, s.x.len(), self.kernel.support());
+        s.cells
+            .neighbor_list_into(&s.x, s.x.len(), self.kernel.support(), &mut s.list);
         s.p.clear();
         s.p.extend_from_slice(&self.state.p);
         s.p.extend_from_slice(&self.walls.p);
