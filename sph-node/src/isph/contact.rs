@@ -343,14 +343,22 @@ mod tests {
             state.t += 1e-3;
         }
         assert!(!layer.any() && layer.face(1).is_none() && layer.corrected() == 0);
-        assert_eq!(layer.age.len() + layer.face.len() + layer.flags.len(), 0, "records held before any correction");
+        assert_eq!(
+            layer.age.len() + layer.face.len() + layer.flags.len(),
+            0,
+            "records held before any correction"
+        );
         // The contact puts particle 1 back along +y by 1e-4 m: it is against a face with normal +y, Δx/2 below it.
         state.x[1][1] += 1e-4;
         layer.detect(&state, dx);
         assert_eq!((layer.corrected(), layer.age.len()), (1, 3));
         let face = layer.face(1).expect("particle 1 against a face");
         assert_eq!(face.normal, [0.0, 1.0]);
-        assert!((face.distance(state.x[1]) - 0.5 * dx).abs() < 1e-15, "{}", face.distance(state.x[1]));
+        assert!(
+            (face.distance(state.x[1]) - 0.5 * dx).abs() < 1e-15,
+            "{}",
+            face.distance(state.x[1])
+        );
         assert!(layer.face(0).is_none() && layer.face(2).is_none());
     }
 }
