@@ -274,6 +274,9 @@ fn serve_session<C: NodeCore>(
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
+        // Counts that change during the run (the fluid's wall guard), before the answer: a status asked for after
+        // it (the broker's, for the summary) has this step's.
+        board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
         idle_since = std::time::Instant::now();
         // A shared buffer: keeping it to answer a repeat costs no copy.
         let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode());
@@ -291,8 +294,6 @@ fn serve_session<C: NodeCore>(
                     s.extra.insert("energy".into(), energy.into());
                 });
             }
-            // Counts that change during the run (the fluid's wall guard) are refreshed with the energies.
-            board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
             energy_at = std::time::Instant::now();
         }
     }

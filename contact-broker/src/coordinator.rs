@@ -148,9 +148,14 @@ pub fn run_with(
         samples: 0,
         timings: Timings::default(),
         contact_stats: ContactStats::default(),
+        counts: Default::default(),
     };
     let mut series = Vec::new();
     let error = drive(scene, &mut nodes, info, plan, progress, &mut summary, &mut series).err();
+    if error.is_some() {
+        // What the nodes still alive counted up to the failure (a finished run asked them before its stop).
+        collect_counts(&mut nodes, &mut summary);
+    }
     // Whatever happened, the probes computed so far are plotted and the summary is written.
     let t_plot = Instant::now();
     if let Err(e) = plot_all(scene, &info.out, &series) {
@@ -360,6 +365,7 @@ fn drive(
             }
         }
     }
+    collect_counts(nodes, summary);
     let stop = command(0.0, false, true);
     if let Some(link) = nodes.fem.as_deref_mut() {
         link.send(step + 1, t, stop.clone())?;
@@ -373,6 +379,16 @@ fn drive(
     summary.timings.broker += started.elapsed().as_secs_f64();
     written?;
     Ok(())
+}
+
+/// Each node's counts into the summary (`Summary::counts`), for the nodes that can say.
+fn collect_counts(nodes: &mut Nodes<'_>, summary: &mut Summary) {
+    if let Some(counts) = nodes.fem.as_deref_mut().and_then(|l| l.counts()) {
+        summary.counts.insert("fem-node".into(), counts);
+    }
+    if let Some(counts) = nodes.sph.as_deref_mut().and_then(|l| l.counts()) {
+        summary.counts.insert("sph-node".into(), counts);
+    }
 }
 
 /// Index k of the first checkpoint time k · `interval` after `t` (times within `slack` before `t` count as reached).

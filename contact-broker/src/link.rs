@@ -4,6 +4,8 @@
 //! physics and the outputs cannot differ between the two modes. Sending and receiving are separate so that the
 //! structure and fluid nodes compute a step at the same time when they run as processes.
 
+use std::collections::BTreeMap;
+
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState, StepCommand};
 
 /// Why a node could not answer.
@@ -78,6 +80,12 @@ pub trait NodeLink {
         true
     }
 
+    /// What the node counts (its sizes, and for the fluid the wall guard's interventions, `wall_pushes`) as it
+    /// reports them on its live status after its last answer; `None` when it cannot say (no status, gone).
+    fn counts(&mut self) -> Option<BTreeMap<String, u64>> {
+        None
+    }
+
     /// The node's whole state after the last step it answered, in its own format, for a checkpoint
     /// (`docs/PROTOCOL.md` §9). Asked for only between two steps.
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError>;
@@ -92,12 +100,15 @@ pub type SphLink = dyn NodeLink<Setup = SphSetup, State = SphState>;
 type Handler<T> = Box<dyn FnMut(&StepCommand) -> Result<Option<T>, LinkError>>;
 /// A node's checkpoint: its state between two steps.
 type Saver = Box<dyn FnMut() -> Result<Vec<u8>, LinkError>>;
+/// A node's counts (see [`NodeLink::counts`]).
+type Counter = Box<dyn FnMut() -> BTreeMap<String, u64>>;
 
 /// A node in this process: a handler called when its answer is asked for.
 pub struct InProcess<S, T> {
     setup: S,
     handler: Handler<T>,
     saver: Option<Saver>,
+    counter: Option<Counter>,
     pending: Option<StepCommand>,
 }
 
@@ -108,8 +119,15 @@ impl<S, T> InProcess<S, T> {
             setup,
             handler: Box::new(handler),
             saver: None,
+            counter: None,
             pending: None,
         }
+    }
+
+    /// The node reports its counts with `counter`.
+    pub fn with_counts(mut self, counter: impl FnMut() -> BTreeMap<String, u64> + 'static) -> Self {
+        self.counter = Some(Box::new(counter));
+        self
     }
 
     /// The node can save its state for a checkpoint with `saver`.
@@ -149,6 +167,10 @@ impl<S, T: Reply> NodeLink for InProcess<S, T> {
 
     fn concurrent(&self) -> bool {
         false
+    }
+
+    fn counts(&mut self) -> Option<BTreeMap<String, u64>> {
+        self.counter.as_mut().map(|count| count())
     }
 
     fn checkpoint(&mut self, _step: u64) -> Result<Vec<u8>, LinkError> {

@@ -1,5 +1,7 @@
 //! `DIR/summary.json` (`DESIGN.md` §5).
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 
 /// Seconds spent per part of the run.
@@ -76,4 +78,9 @@ pub struct Summary {
     pub timings: Timings,
     /// Contact statistics.
     pub contact_stats: ContactStats,
+    /// What each node counted, by node (`fem-node`, `sph-node`), as it reported at the end of the run: its sizes,
+    /// and for the WCSPH fluid `wall_pushes`, the particles its wall guard put back out of a wall over the run (a
+    /// run that needed many of them is a run to look at). Empty for a node that could not say.
+    #[serde(default)]
+    pub counts: BTreeMap<String, BTreeMap<String, u64>>,
 }

@@ -1,6 +1,7 @@
 //! The broker's zenoh side: session, the `scene` queryable, node registration and the per-step exchange with a
 //! structure node in another process. Everything the coordinator needs is behind [`FemLink`].
 
+use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use cosim_proto::envelope::{CodecError, Envelope};
@@ -221,6 +222,9 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     }
 }
 
+/// How long the broker waits for a node's live status at the end of a run (for the summary's counts).
+const COUNTS_TIMEOUT: Duration = Duration::from_secs(2);
+
 impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S, T> {
     type Setup = S;
     type State = T;
@@ -268,6 +272,25 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             return Err(self.failed(format!("sent a checkpoint of a {}", env.body.node)));
         }
         Ok(env.body.data)
+    }
+
+    fn counts(&mut self) -> Option<BTreeMap<String, u64>> {
+        // The node's live status (`cosim/<run>/<node>/status`, JSON), whose counts it refreshes before each answer.
+        let replies = self
+            .session
+            .get(key(&self.run, self.topics.status))
+            .timeout(COUNTS_TIMEOUT)
+            .wait()
+            .ok()?;
+        let sample = replies.recv().ok()?.into_result().ok()?;
+        let status: serde_json::Value = serde_json::from_slice(&sample.payload().to_bytes()).ok()?;
+        let counts = status.get("counts")?.as_object()?;
+        Some(
+            counts
+                .iter()
+                .filter_map(|(k, v)| Some((k.clone(), v.as_u64()?)))
+                .collect(),
+        )
     }
 
     fn receive(&mut self, step: u64) -> Result<T, LinkError> {

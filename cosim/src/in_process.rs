@@ -27,10 +27,20 @@ where
     };
     let core = Rc::new(RefCell::new(core));
     let saving = Rc::clone(&core);
-    InProcess::new(setup, move |cmd| core.borrow_mut().handle(cmd).map_err(error)).with_checkpoint(move || {
-        saving.borrow().checkpoint().ok_or_else(|| LinkError::Failed {
-            node: name.into(),
-            message: "cannot save a checkpoint".into(),
+    let counting = Rc::clone(&core);
+    InProcess::new(setup, move |cmd| core.borrow_mut().handle(cmd).map_err(error))
+        .with_checkpoint(move || {
+            saving.borrow().checkpoint().ok_or_else(|| LinkError::Failed {
+                node: name.into(),
+                message: "cannot save a checkpoint".into(),
+            })
         })
-    })
+        .with_counts(move || {
+            counting
+                .borrow()
+                .counts()
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect()
+        })
 }

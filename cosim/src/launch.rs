@@ -418,5 +418,6 @@ fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {
         samples: 0,
         timings: Default::default(),
         contact_stats: Default::default(),
+        counts: Default::default(),
     }
 }

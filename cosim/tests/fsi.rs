@@ -149,6 +149,16 @@ fn coarse_gate_replays_in_process_bit_for_bit() {
     assert_eq!(pa, pb, "in-process differs from processes");
     let s = json(&a.join("summary.json"));
     assert_eq!(s["mode"], "processes");
+    // What the nodes counted reaches the summary, the same in both modes: the fluid's sizes and its wall guard.
+    let counts = &s["counts"];
+    assert_eq!(
+        counts,
+        &json(&b.join("summary.json"))["counts"],
+        "counts differ between the modes"
+    );
+    assert_eq!(counts["sph-node"]["particles"], s["particles"]);
+    assert_eq!(counts["fem-node"]["nodes"], s["fem_nodes"]);
+    assert!(counts["sph-node"]["wall_pushes"].is_u64(), "no wall_pushes in {counts}");
     assert!(
         s["contact_stats"]["contacts"].as_u64().unwrap() > 0,
         "the water pushes on the gate"

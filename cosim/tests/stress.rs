@@ -215,6 +215,13 @@ fn tall_dam_break_slams_into_the_far_wall_and_stays_bounded() {
             "{case}: only {:.3} of the budget dissipated",
             -energy.2
         );
+        // The summary says how often the WCSPH wall guard put a particle back out of a wall: never here, the wall
+        // repulsion holds the water off the walls through the impact. ISPH has no such count.
+        let pushes = &out.summary["counts"]["sph-node"]["wall_pushes"];
+        match solver {
+            "wcsph" => assert_eq!(pushes.as_u64(), Some(0), "{case}: wall_pushes {pushes}"),
+            _ => assert!(pushes.is_null(), "{case}: wall_pushes {pushes}"),
+        }
     }
 }
 
