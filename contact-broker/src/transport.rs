@@ -222,8 +222,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     }
 }
 
-/// How long the broker waits for a node's live status at the end of a run (for the summary's counts).
-const COUNTS_TIMEOUT: Duration = Duration::from_secs(2);
+/// How long the broker waits for a node's live status at the end of a run (for the summary's counts). A node
+/// answers it from its zenoh threads whatever it is computing, within milliseconds; one that is gone (a failed run)
+/// costs the whole wait.
+const COUNTS_TIMEOUT: Duration = Duration::from_millis(500);
 
 impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S, T> {
     type Setup = S;
