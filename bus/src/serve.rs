@@ -2,6 +2,7 @@
 //! answer step commands until told to stop. Generic over the node, so the structure and fluid nodes (and any
 //! future one) speak the protocol through the same code.
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 use anyhow::Context;
@@ -88,6 +89,11 @@ pub trait NodeCore {
             message: "this node cannot continue from a checkpoint".into(),
         })
     }
+}
+
+/// `core`'s counts as the live status and `summary.json` hold them (name → count).
+pub fn counts_of<C: NodeCore + ?Sized>(core: &C) -> BTreeMap<String, u64> {
+    core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect()
 }
 
 /// How often the live status's energies are recomputed (they cost a pass over the particles or elements).
@@ -199,7 +205,7 @@ fn serve_session<C: NodeCore>(
             s.t = saved.t;
         });
     }
-    board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
+    board.update(|s| s.counts = counts_of(&core));
     let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
     session
         .put(key(run, topics.setup), setup)
@@ -276,7 +282,7 @@ fn serve_session<C: NodeCore>(
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);
         // Counts that change during the run (the fluid's wall guard), before the answer: a status asked for after
         // it (the broker's, for the summary) has this step's.
-        board.update(|s| s.counts = core.counts().into_iter().map(|(k, v)| (k.to_string(), v)).collect());
+        board.update(|s| s.counts = counts_of(&core));
         idle_since = std::time::Instant::now();
         // A shared buffer: keeping it to answer a repeat costs no copy.
         let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode());

@@ -5,7 +5,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use contact_broker::link::{InProcess, LinkError, Reply};
-use cosim_bus::serve::{Failure, NodeCore};
+use cosim_bus::serve::{counts_of, Failure, NodeCore};
 
 /// A node, in this process; `name` labels its errors.
 pub fn link<C>(name: &'static str, core: C) -> InProcess<C::Setup, C::State>
@@ -35,12 +35,5 @@ where
                 message: "cannot save a checkpoint".into(),
             })
         })
-        .with_counts(move || {
-            counting
-                .borrow()
-                .counts()
-                .into_iter()
-                .map(|(k, v)| (k.to_string(), v))
-                .collect()
-        })
+        .with_counts(move || counts_of(&*counting.borrow()))
 }

@@ -60,7 +60,7 @@ impl SparseRows {
         let mut m = Self::default();
         m.assemble(
             rows.len(),
-            &mut vec![0.0; rows.len()],
+            &mut Vec::new(),
             |i| rows[i].len(),
             |i, row| {
                 for &(c, v) in &rows[i] {
