@@ -61,7 +61,7 @@ fn main() {
     let fem = fem_node::core::FemCore::new(&scene).unwrap();
     let mut sph = sph_node::core::SphCore::new(&scene).unwrap();
     let mesh = fem.mesh();
-    let mut interface = Interface::new(&scene, mesh, sph.setup());
+    let mut interface = Interface::new(&scene, mesh, sph.setup()).expect("the shipped scene's mesh is valid");
     let ids = interface.node_ids().to_vec();
     let x: Vec<[f64; 2]> = ids.iter().map(|&id| mesh.nodes[id as usize]).collect();
     let roi = interface.roi(&x);

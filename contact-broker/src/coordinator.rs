@@ -10,6 +10,7 @@ use anyhow::Context;
 
 use cosim_proto::messages::{FemMesh, FemState, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{LoadedScene, SceneError};
+use cosim_proto::validate::{Asked, Invalid};
 
 use crate::checkpoint::{self, BrokerState};
 use crate::interface::{Corrections, Interface, PassStats};
@@ -197,6 +198,17 @@ fn drive(
     series: &mut Series,
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
+    // docs/PROTOCOL.md §7 "Contents": the registrations are checked before anything indexes them.
+    if let Some(link) = &nodes.fem {
+        link.setup().validate().map_err(|e| unusable("fem-node", e))?;
+    }
+    if let Some(link) = &nodes.sph {
+        link.setup().validate().map_err(|e| unusable("sph-node", e))?;
+    }
+    let interface_ids = nodes
+        .fem
+        .as_ref()
+        .map_or_else(Vec::new, |f| f.setup().interface_nodes());
     let probes = Probes::resolve(
         s,
         nodes.fem.as_ref().map(|f| f.setup()),
@@ -228,7 +240,7 @@ fn drive(
 
     // DESIGN.md §3: with both a structure and a fluid the broker runs the contact pass between steps.
     let mut interface = match (&nodes.fem, &nodes.sph) {
-        (Some(f), Some(p)) => Some(Interface::new(s, f.setup(), p.setup())),
+        (Some(f), Some(p)) => Some(Interface::new(s, f.setup(), p.setup())?),
         _ => None,
     };
     let mut roi = interface.as_ref().map(|i| {
@@ -278,7 +290,14 @@ fn drive(
             summary.contact_stats = s.contact_stats.clone();
         }
         None => {
-            let mut round = exchange(nodes, summary, step, t, commands(0.0, true, coupled, roi, &mut pending))?;
+            let mut round = exchange(
+                nodes,
+                &interface_ids,
+                summary,
+                step,
+                t,
+                commands(0.0, true, coupled, roi, &mut pending),
+            )?;
             out.sample(t, &mut round, nodes, load.as_deref(), summary)?;
         }
     }
@@ -297,7 +316,14 @@ fn drive(
             dt = target - t;
         }
         step += 1;
-        let mut round = exchange(nodes, summary, step, t, commands(dt, lands, coupled, roi, &mut pending))?;
+        let mut round = exchange(
+            nodes,
+            &interface_ids,
+            summary,
+            step,
+            t,
+            commands(dt, lands, coupled, roi, &mut pending),
+        )?;
         if let Some(state) = &round.fem {
             summary.fem_substeps += u64::from(state.substeps);
         }
@@ -558,12 +584,19 @@ fn write_particles(
 /// `receive` (in this process).
 fn exchange(
     nodes: &mut Nodes<'_>,
+    interface_ids: &[u32],
     summary: &mut Summary,
     step: u64,
     t: f64,
     (fem_cmd, sph_cmd): (StepCommand, StepCommand),
 ) -> anyhow::Result<Round> {
     let context = || format!("coupling step {step} from t = {t} s");
+    let asked = |cmd: &StepCommand| Asked {
+        interface: cmd.want_interface,
+        snapshot: cmd.want_snapshot,
+        interface_ids,
+    };
+    let (fem_asked, sph_asked) = (asked(&fem_cmd), asked(&sph_cmd));
     let started = Instant::now();
     if let Some(link) = nodes.sph.as_deref_mut() {
         link.send(step, t, sph_cmd).with_context(context)?;
@@ -571,12 +604,28 @@ fn exchange(
     if let Some(link) = nodes.fem.as_deref_mut() {
         link.send(step, t, fem_cmd).with_context(context)?;
     }
+    // docs/PROTOCOL.md §7 "Contents": each answer is checked against the node's registration and the command
+    // before anything reads it.
     let sph = match nodes.sph.as_deref_mut() {
-        Some(link) => Some(link.receive(step).with_context(context)?),
+        Some(link) => {
+            let state = link.receive(step).with_context(context)?;
+            state
+                .validate(link.setup(), sph_asked)
+                .map_err(|e| unusable("sph-node", e))
+                .with_context(context)?;
+            Some(state)
+        }
         None => None,
     };
     let fem = match nodes.fem.as_deref_mut() {
-        Some(link) => Some(link.receive(step).with_context(context)?),
+        Some(link) => {
+            let state = link.receive(step).with_context(context)?;
+            state
+                .validate(link.setup(), fem_asked)
+                .map_err(|e| unusable("fem-node", e))
+                .with_context(context)?;
+            Some(state)
+        }
         None => None,
     };
     let wall = started.elapsed().as_secs_f64();
@@ -597,6 +646,17 @@ fn exchange(
     }
     summary.timings.messaging += (wall - side_by_side - in_turn).max(0.0);
     Ok(Round { fem, sph })
+}
+
+/// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state,
+/// ends `unstable`: the node blew up without noticing), naming the message, the field, the index and the value.
+fn unusable(node: &str, e: Invalid) -> LinkError {
+    let (node, message) = (node.to_string(), format!("sent an unusable message: {e}"));
+    if e.is_non_finite() {
+        LinkError::Unstable { node, message }
+    } else {
+        LinkError::Failed { node, message }
+    }
 }
 
 fn plot_all(scene: &LoadedScene, out: &Path, series: &Series) -> anyhow::Result<()> {

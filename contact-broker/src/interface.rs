@@ -52,9 +52,13 @@ pub struct Interface {
 
 impl Interface {
     /// The interface of `mesh` (its boundary segments, lumped masses and clamped nodes) against `sph`'s particles.
-    pub fn new(scene: &Scene, mesh: &FemMesh, sph: &SphSetup) -> Self {
+    ///
+    /// `mesh` must have passed [`FemMesh::validate`] (its ids in range, one mass per node); a mesh that did not is
+    /// refused here too, never indexed out of range.
+    pub fn new(scene: &Scene, mesh: &FemMesh, sph: &SphSetup) -> anyhow::Result<Self> {
         let node_ids = mesh.interface_nodes();
-        let local = |id: u32| node_ids.binary_search(&id).expect("interface node");
+        // Every segment end is in `node_ids`, which is made of them.
+        let local = |id: u32| node_ids.binary_search(&id).unwrap_or_default();
         let segments = mesh
             .interface
             .iter()
@@ -63,8 +67,27 @@ impl Interface {
                 b: local(s.b),
             })
             .collect();
-        let masses = node_ids.iter().map(|&id| mesh.masses[id as usize]).collect();
-        let fixed = node_ids.iter().map(|id| mesh.fixed.binary_search(id).is_ok()).collect();
+        let masses = node_ids
+            .iter()
+            .map(|&id| {
+                mesh.masses.get(id as usize).copied().ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "fem/mesh interface node {id} has no mass ({} masses)",
+                        mesh.masses.len()
+                    )
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let mut clamped = vec![false; mesh.nodes.len()];
+        for &id in &mesh.fixed {
+            if let Some(c) = clamped.get_mut(id as usize) {
+                *c = true;
+            }
+        }
+        let fixed = node_ids
+            .iter()
+            .map(|&id| clamped.get(id as usize).copied().unwrap_or(false))
+            .collect();
         let dx = sph.spacing;
         let thickness = scene.contact.thickness.unwrap_or(0.5 * dx);
         let sweeps = scene.contact.sweeps;
@@ -97,7 +120,7 @@ impl Interface {
             spacing: 0.5 * thickness,
             ..contact::ParticleParticleParams::monaghan(dx, g, depth)
         };
-        Self {
+        Ok(Self {
             algorithm: scene.contact.algorithm,
             node_ids,
             segments,
@@ -111,7 +134,7 @@ impl Interface {
             workspace: ContactWorkspace::default(),
             impulse: vec![[0.0; 2]; mesh.nodes.len()],
             dt: 0.0,
-        }
+        })
     }
 
     /// The FE ids of the interface nodes, in the order the structure node reports them.
@@ -147,11 +170,23 @@ impl Interface {
 
     /// One contact pass (§3 step 4) on the states both nodes answered after a step of length `dt`.
     pub fn pass(&mut self, fem: &FemState, sph: &SphState, dt: f64) -> anyhow::Result<(Corrections, PassStats)> {
+        // The coordinator checked both states (FemState::validate, SphState::validate); a pass called without that
+        // check is refused here rather than indexing past an array.
         anyhow::ensure!(
-            fem.ids == self.node_ids,
-            "fem-node reported {} interface nodes, the mesh has {}",
+            fem.ids == self.node_ids && fem.x.len() == fem.ids.len() && fem.v.len() == fem.ids.len(),
+            "fem/state does not report the mesh's {} interface nodes (ids {}, x {}, v {})",
+            self.node_ids.len(),
             fem.ids.len(),
-            self.node_ids.len()
+            fem.x.len(),
+            fem.v.len()
+        );
+        anyhow::ensure!(
+            sph.x.len() == sph.ids.len() && sph.v.len() == sph.ids.len() && sph.m.len() == sph.ids.len(),
+            "sph/state arrays disagree (ids {}, x {}, v {}, m {})",
+            sph.ids.len(),
+            sph.x.len(),
+            sph.v.len(),
+            sph.m.len()
         );
         for j in &mut self.impulse {
             *j = [0.0; 2];
@@ -213,8 +248,10 @@ impl Interface {
             load_y = node_impulse.iter().map(|j| j[1]).sum::<f64>() / dt,
             "contact pass"
         );
-        for (k, j) in node_impulse.iter().enumerate() {
-            self.impulse[self.node_ids[k] as usize] = *j;
+        for (&id, j) in self.node_ids.iter().zip(&node_impulse) {
+            if let Some(slot) = self.impulse.get_mut(id as usize) {
+                *slot = *j;
+            }
         }
         let (lin, ang) = momentum_change((&sph.m, &sph.v, &px, &pv), &nx, &node_impulse);
         stats.linear_momentum_change = lin;

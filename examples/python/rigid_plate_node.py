@@ -159,9 +159,10 @@ class RigidPlate:
 
     def apply(self, corrections):
         """Velocity corrections are impulses m_a dv_a on the body; position corrections shift it (mass-weighted)."""
+        for node_id, _, _ in corrections:
+            if node_id >= len(self.masses):  # PROTOCOL.md §7: a correction for an unknown node is an error
+                raise ValueError(f"corrections: node {node_id} out of range ({len(self.masses)} nodes)")
         for node_id, dx, dv in corrections:
-            if node_id >= len(self.masses):
-                continue  # PROTOCOL.md §8: ids out of range are skipped
             m = self.masses[node_id]
             for k in range(2):
                 self.v[k] += m * dv[k] / self.mass
@@ -296,7 +297,10 @@ def main():
                 raise ValueError(f"step {cmd['step']}, expected {expected}")
         except (ValueError, struct.error, UnicodeDecodeError) as e:
             fail(f"refused a command: {e}")  # PROTOCOL.md §7: never applied
-        plate.apply(cmd["corrections"])
+        try:
+            plate.apply(cmd["corrections"])
+        except ValueError as e:
+            fail(f"unusable command: {e}")
         if cmd["stop"]:
             break
         substeps = plate.advance(cmd["dt"]) if cmd["dt"] > 0 else 0

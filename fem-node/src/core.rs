@@ -19,6 +19,8 @@ pub struct FemCore {
     solver: FemSolver,
     mesh: FemMesh,
     interface_nodes: Vec<u32>,
+    /// `coupling.max_dt`: no command may ask for a longer step.
+    max_dt: f64,
 }
 
 impl FemCore {
@@ -32,6 +34,7 @@ impl FemCore {
             solver,
             mesh,
             interface_nodes,
+            max_dt: scene.coupling.max_dt,
         })
     }
 
@@ -74,7 +77,13 @@ impl FemCore {
     /// Apply the corrections, advance by `dt`, and answer. `None` for a stop command.
     pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<FemState>, FemError> {
         let started = Instant::now();
-        self.solver.apply_corrections(&cmd.corrections);
+        // docs/PROTOCOL.md §7 "Contents": nothing of a command is applied before all of it is checked.
+        cmd.validate("broker/fem", self.mesh.nodes.len(), self.max_dt)
+            .map_err(|e| FemError::InvalidParameter {
+                name: "command",
+                message: e.to_string(),
+            })?;
+        self.solver.apply_corrections(&cmd.corrections)?;
         if cmd.stop {
             return Ok(None);
         }

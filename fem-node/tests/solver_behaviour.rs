@@ -57,12 +57,31 @@ fn clamped_nodes_stay_put_and_ignore_corrections() {
             dx: [0.0, 1e-4],
             dv: [0.0, 0.5],
         },
+    ])
+    .unwrap();
+    // A correction for a node the mesh does not have is an error, and nothing of its list is applied.
+    let before = s.state().clone();
+    let unknown = s.apply_corrections(&[
+        Correction {
+            id: free as u32,
+            dx: [0.0, 1.0],
+            dv: [0.0, 1.0],
+        },
         Correction {
             id: u32::MAX,
             dx: [1.0, 1.0],
             dv: [1.0, 1.0],
         },
     ]);
+    assert_eq!(
+        unknown.unwrap_err().to_string(),
+        format!(
+            "corrections: correction for node {}, but the mesh has {} nodes",
+            u32::MAX,
+            s.model().node_count()
+        )
+    );
+    assert_eq!(s.state().x, before.x);
     let x_free = s.state().x[free];
     assert_eq!(s.state().v[free], [0.0, 0.5]);
     assert!((x_free[1] - 0.01 - 1e-4).abs() < 1e-15);
@@ -82,7 +101,8 @@ fn inverted_element_is_a_typed_error() {
         id: k as u32,
         dx: [-0.015, 0.03],
         dv: [0.0; 2],
-    }]);
+    }])
+    .unwrap();
     match s.advance(1e-4) {
         Err(FemError::Unstable { element, reason, .. }) => {
             assert!(

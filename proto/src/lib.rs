@@ -7,5 +7,6 @@ pub mod keys;
 pub mod messages;
 pub mod scene;
 pub mod session;
+pub mod validate;
 
 pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

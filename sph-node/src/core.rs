@@ -112,6 +112,8 @@ pub struct SphCore {
     solver: Fluid,
     setup: SphSetup,
     guard: EnergyGuard,
+    /// `coupling.max_dt`: no command may ask for a longer step.
+    max_dt: f64,
 }
 
 impl SphCore {
@@ -128,7 +130,12 @@ impl SphCore {
             dt_stable: solver.stable_dt(),
         };
         let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity);
-        Ok(Self { solver, setup, guard })
+        Ok(Self {
+            solver,
+            setup,
+            guard,
+            max_dt: scene.coupling.max_dt,
+        })
     }
 
     /// The `sph/setup` registration message.
@@ -201,6 +208,12 @@ impl SphCore {
     /// Apply the corrections, advance by `dt` (in as many stable steps as it takes) and answer. `None` for a stop.
     pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, SphError> {
         let started = Instant::now();
+        // docs/PROTOCOL.md §7 "Contents": nothing of a command is applied before all of it is checked.
+        cmd.validate("broker/sph", self.setup.particles as usize, self.max_dt)
+            .map_err(|e| SphError::InvalidParameter {
+                name: "command",
+                message: e.to_string(),
+            })?;
         // DESIGN.md §3 step 5: the contact corrections of the last step, applied before this one.
         self.apply_corrections(&cmd.corrections)?;
         if cmd.stop {

@@ -205,12 +205,20 @@ impl FemSolver {
         Ok(())
     }
 
-    /// Applies contact corrections: `x += dx`, `v += dv` on free nodes; clamped nodes and unknown ids are skipped.
+    /// Applies contact corrections: `x += dx`, `v += dv` on free nodes; clamped nodes are skipped, and a
+    /// correction for a node the mesh does not have is an error (as in the fluid node), applied to nothing.
     /// Accelerations are refreshed before the next step when a position moved.
-    pub fn apply_corrections(&mut self, corrections: &[Correction]) {
+    pub fn apply_corrections(&mut self, corrections: &[Correction]) -> Result<()> {
+        let n = self.state.x.len();
+        if let Some(c) = corrections.iter().find(|c| c.id as usize >= n) {
+            return Err(FemError::InvalidParameter {
+                name: "corrections",
+                message: format!("correction for node {}, but the mesh has {n} nodes", c.id),
+            });
+        }
         for c in corrections {
             let k = c.id as usize;
-            if k >= self.state.x.len() || self.model.fixed()[k] {
+            if self.model.fixed()[k] {
                 continue;
             }
             for d in 0..2 {
@@ -223,6 +231,7 @@ impl FemSolver {
                 self.accelerations_stale = true;
             }
         }
+        Ok(())
     }
 
     /// Kinetic `½ Σ m v²`, strain `Σ_e (W(F) A + hourglass energy)` and potential `−Σ m g·(x − X)` energy of

@@ -1,0 +1,543 @@
+//! Message-level fuzzing of the trust boundary (`docs/PROTOCOL.md` §7 "Contents"): well-framed messages with
+//! inconsistent contents — ids out of range, lengths that disagree, NaN and infinities, negative masses, empty and
+//! huge arrays — fed to the broker's coordinator (as the answers of real in-process nodes, spoilt at a random step)
+//! and to both nodes' command handlers. None may panic or hang; each is refused, naming the field, and a node given an
+//! unusable command applies none of it.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use contact_broker::coordinator::{self, Control, Nodes, RunInfo};
+use contact_broker::link::{InProcess, LinkError};
+use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState, StepCommand};
+use cosim_proto::scene::{self, LoadedScene};
+use fem_node::core::FemCore;
+use proptest::prelude::*;
+use sph_node::core::SphCore;
+
+/// The hydrostatic plate, coarse: 200 fluid particles on a 20 × 2 plate, 12 coupling steps, output every 4.
+fn scene() -> LoadedScene {
+    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/hydrostatic_plate.toml"));
+    let overrides = [
+        "fluid.spacing=0.1",
+        "solid[0].divisions=[20, 2]",
+        "run.end_time=0.0012",
+        "run.output_interval=0.0004",
+    ];
+    scene::load(&path, &overrides.map(String::from)).expect("the shipped scene loads")
+}
+
+fn out_dir() -> PathBuf {
+    static N: AtomicU64 = AtomicU64::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "cosim-message-fuzz-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("temporary folder");
+    dir
+}
+
+/// One inconsistency, put into one message of the run.
+#[derive(Clone, Debug)]
+enum Spoil {
+    Mesh(MeshSpoil),
+    Fem { step: u64, how: FemSpoil },
+    Setup(SetupSpoil),
+    Sph { step: u64, how: SphSpoil },
+}
+
+#[derive(Clone, Debug)]
+enum MeshSpoil {
+    SegmentEnd(usize, u32),
+    FewerMasses(usize),
+    Mass(usize, f64),
+    Node(usize, f64),
+    NodeSolid(usize, u32),
+    CellNode(usize, u32),
+    ShortCell(usize),
+    Fixed(u32),
+    DtStable(f64),
+    NoNodes,
+    NoSolids,
+    HugeCellSolid(usize),
+}
+
+#[derive(Clone, Debug)]
+enum FemSpoil {
+    Id(usize, u32),
+    DropId,
+    ShortX,
+    X(usize, f64),
+    SnapshotShort,
+    StressShort,
+    NoSnapshot,
+    DtStable(f64),
+    Seconds(f64),
+}
+
+#[derive(Clone, Debug)]
+enum SetupSpoil {
+    Spacing(f64),
+    H(f64),
+    Wall(usize, f64),
+    DtStable(f64),
+}
+
+#[derive(Clone, Debug)]
+enum SphSpoil {
+    Id(u32),
+    Duplicate,
+    ShortM,
+    Mass(f64),
+    X(f64),
+    SnapshotShort,
+    WallPShort,
+    Rho(f64),
+    DtStable(f64),
+    HugeIds(usize),
+}
+
+fn bad_number() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)]
+}
+
+fn not_positive() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(0.0),
+        Just(-1.0),
+        Just(-1e-300),
+        Just(f64::NAN),
+        Just(f64::NEG_INFINITY)
+    ]
+}
+
+fn spoils() -> impl Strategy<Value = Spoil> {
+    let mesh = prop_oneof![
+        (any::<usize>(), any::<u32>()).prop_map(|(i, v)| MeshSpoil::SegmentEnd(i, v)),
+        (1usize..50).prop_map(MeshSpoil::FewerMasses),
+        (any::<usize>(), not_positive()).prop_map(|(i, v)| MeshSpoil::Mass(i, v)),
+        (any::<usize>(), bad_number()).prop_map(|(i, v)| MeshSpoil::Node(i, v)),
+        (any::<usize>(), 1u32..).prop_map(|(i, v)| MeshSpoil::NodeSolid(i, v)),
+        (any::<usize>(), any::<u32>()).prop_map(|(i, v)| MeshSpoil::CellNode(i, v)),
+        any::<usize>().prop_map(MeshSpoil::ShortCell),
+        any::<u32>().prop_map(MeshSpoil::Fixed),
+        not_positive().prop_map(MeshSpoil::DtStable),
+        Just(MeshSpoil::NoNodes),
+        Just(MeshSpoil::NoSolids),
+        (1usize..200_000).prop_map(MeshSpoil::HugeCellSolid),
+    ];
+    let fem = prop_oneof![
+        (any::<usize>(), any::<u32>()).prop_map(|(i, v)| FemSpoil::Id(i, v)),
+        Just(FemSpoil::DropId),
+        Just(FemSpoil::ShortX),
+        (any::<usize>(), bad_number()).prop_map(|(i, v)| FemSpoil::X(i, v)),
+        Just(FemSpoil::SnapshotShort),
+        Just(FemSpoil::StressShort),
+        Just(FemSpoil::NoSnapshot),
+        not_positive().prop_map(FemSpoil::DtStable),
+        prop_oneof![Just(f64::NAN), Just(-1.0)].prop_map(FemSpoil::Seconds),
+    ];
+    let setup = prop_oneof![
+        not_positive().prop_map(SetupSpoil::Spacing),
+        not_positive().prop_map(SetupSpoil::H),
+        (any::<usize>(), bad_number()).prop_map(|(i, v)| SetupSpoil::Wall(i, v)),
+        prop_oneof![Just(0.0), Just(-1e-4), Just(f64::NAN)].prop_map(SetupSpoil::DtStable),
+    ];
+    let sph = prop_oneof![
+        (200u32..).prop_map(SphSpoil::Id),
+        Just(SphSpoil::Duplicate),
+        Just(SphSpoil::ShortM),
+        not_positive().prop_map(SphSpoil::Mass),
+        bad_number().prop_map(SphSpoil::X),
+        Just(SphSpoil::SnapshotShort),
+        Just(SphSpoil::WallPShort),
+        not_positive().prop_map(SphSpoil::Rho),
+        // A zero or NaN stable step made the coordinator take zero-length steps for ever.
+        prop_oneof![Just(0.0), Just(-1e-4), Just(f64::NAN)].prop_map(SphSpoil::DtStable),
+        (1usize..300_000).prop_map(SphSpoil::HugeIds),
+    ];
+    prop_oneof![
+        mesh.prop_map(Spoil::Mesh),
+        (0u64..=12, fem).prop_map(|(step, how)| Spoil::Fem { step, how }),
+        setup.prop_map(Spoil::Setup),
+        (0u64..=12, sph).prop_map(|(step, how)| Spoil::Sph { step, how }),
+    ]
+}
+
+fn pick(i: usize, len: usize) -> usize {
+    i % len.max(1)
+}
+
+fn spoil_mesh(m: &mut FemMesh, how: &MeshSpoil) -> &'static str {
+    let n = m.nodes.len() as u32;
+    match *how {
+        MeshSpoil::SegmentEnd(i, v) => {
+            let k = pick(i, m.interface.len());
+            m.interface[k].b = n + v % (u32::MAX - n);
+            "interface"
+        }
+        MeshSpoil::FewerMasses(k) => {
+            m.masses.truncate(m.masses.len().saturating_sub(k));
+            "masses"
+        }
+        MeshSpoil::Mass(i, v) => {
+            let k = pick(i, m.masses.len());
+            m.masses[k] = v;
+            "masses"
+        }
+        MeshSpoil::Node(i, v) => {
+            let k = pick(i, m.nodes.len());
+            m.nodes[k][i % 2] = v;
+            "nodes"
+        }
+        MeshSpoil::NodeSolid(i, v) => {
+            let k = pick(i, m.node_solid.len());
+            m.node_solid[k] = v;
+            "node_solid"
+        }
+        MeshSpoil::CellNode(i, v) => {
+            let k = pick(i, m.cells.len());
+            m.cells[k][i % 3] = n + v % (u32::MAX - n);
+            "cells"
+        }
+        MeshSpoil::ShortCell(i) => {
+            let k = pick(i, m.cells.len());
+            m.cells[k].truncate(2);
+            "cells"
+        }
+        MeshSpoil::Fixed(v) => {
+            m.fixed.push(n + v % (u32::MAX - n));
+            "fixed"
+        }
+        MeshSpoil::DtStable(v) => {
+            m.dt_stable = v;
+            "dt_stable"
+        }
+        MeshSpoil::NoNodes => {
+            m.nodes.clear();
+            "nodes"
+        }
+        MeshSpoil::NoSolids => {
+            m.solid_names.clear();
+            "solid_names"
+        }
+        MeshSpoil::HugeCellSolid(k) => {
+            m.cell_solid.extend(std::iter::repeat_n(0, k));
+            "cell_solid"
+        }
+    }
+}
+
+fn spoil_fem(s: &mut FemState, how: &FemSpoil) -> Option<&'static str> {
+    match *how {
+        FemSpoil::Id(i, v) if !s.ids.is_empty() => {
+            let k = pick(i, s.ids.len());
+            s.ids[k] = s.ids[k].wrapping_add(1 + v % (u32::MAX - 1));
+            Some("ids")
+        }
+        FemSpoil::DropId if !s.ids.is_empty() => {
+            s.ids.pop();
+            Some("ids")
+        }
+        FemSpoil::ShortX if !s.x.is_empty() => {
+            s.x.pop();
+            Some("x")
+        }
+        FemSpoil::X(i, v) if !s.x.is_empty() => {
+            let k = pick(i, s.x.len());
+            s.x[k][i % 2] = v;
+            Some("x")
+        }
+        FemSpoil::SnapshotShort => s.snapshot.as_mut().map(|snap| {
+            snap.x.pop();
+            "x"
+        }),
+        FemSpoil::StressShort => s.snapshot.as_mut().map(|snap| {
+            snap.stress.pop();
+            "stress"
+        }),
+        FemSpoil::NoSnapshot => s.snapshot.take().map(|_| "snapshot"),
+        FemSpoil::DtStable(v) => {
+            s.dt_stable = v;
+            Some("dt_stable")
+        }
+        FemSpoil::Seconds(v) => {
+            s.compute_seconds = v;
+            Some("compute_seconds")
+        }
+        _ => None,
+    }
+}
+
+fn spoil_setup(s: &mut SphSetup, how: &SetupSpoil) -> &'static str {
+    match *how {
+        SetupSpoil::Spacing(v) => {
+            s.spacing = v;
+            "spacing"
+        }
+        SetupSpoil::H(v) => {
+            s.h = v;
+            "h"
+        }
+        SetupSpoil::Wall(i, v) => {
+            let k = pick(i, s.walls.len());
+            s.walls[k][i % 2] = v;
+            "walls"
+        }
+        SetupSpoil::DtStable(v) => {
+            s.dt_stable = v;
+            "dt_stable"
+        }
+    }
+}
+
+fn spoil_sph(s: &mut SphState, particles: u32, how: &SphSpoil) -> Option<&'static str> {
+    match *how {
+        SphSpoil::Id(v) if !s.ids.is_empty() => {
+            let last = s.ids.len() - 1;
+            s.ids[last] = v.max(particles);
+            Some("ids")
+        }
+        SphSpoil::Duplicate if s.ids.len() >= 2 => {
+            s.ids[1] = s.ids[0];
+            Some("ids")
+        }
+        SphSpoil::ShortM if !s.m.is_empty() => {
+            s.m.pop();
+            Some("m")
+        }
+        SphSpoil::Mass(v) if !s.m.is_empty() => {
+            s.m[0] = v;
+            Some("m")
+        }
+        SphSpoil::X(v) if !s.x.is_empty() => {
+            s.x[0][1] = v;
+            Some("x")
+        }
+        SphSpoil::SnapshotShort => s.snapshot.as_mut().map(|snap| {
+            snap.p.pop();
+            "p"
+        }),
+        SphSpoil::WallPShort => s.snapshot.as_mut().map(|snap| {
+            snap.wall_p.clear();
+            "wall_p"
+        }),
+        SphSpoil::Rho(v) => s.snapshot.as_mut().map(|snap| {
+            snap.rho[0] = v;
+            "rho"
+        }),
+        SphSpoil::DtStable(v) => {
+            s.dt_stable = v;
+            Some("dt_stable")
+        }
+        SphSpoil::HugeIds(k) => {
+            // Ids beyond the particle count, with positions, velocities and masses to match.
+            s.ids.extend((0..k as u32).map(|i| particles.saturating_add(i)));
+            s.x.resize(s.ids.len(), [0.0; 2]);
+            s.v.resize(s.ids.len(), [0.0; 2]);
+            s.m.resize(s.ids.len(), 1.0);
+            Some("ids")
+        }
+        _ => None,
+    }
+}
+
+/// What a spoilt run ended with: its status and message, and the field the spoil named (None when the spoil did not
+/// apply to any message of this run, e.g. a snapshot spoil at a step without one).
+fn run_spoilt(spoil: &Spoil) -> (String, String, Option<&'static str>) {
+    let scene = scene();
+    let fem = FemCore::new(&scene.scene).expect("fem core");
+    let sph = SphCore::new(&scene.scene).expect("sph core");
+    let particles = sph.setup().particles;
+    let (mut mesh, mut setup) = (fem.mesh().clone(), sph.setup().clone());
+    let mut field = None;
+    match spoil {
+        Spoil::Mesh(how) => field = Some(spoil_mesh(&mut mesh, how)),
+        Spoil::Setup(how) => field = Some(spoil_setup(&mut setup, how)),
+        _ => {}
+    }
+    let applied = std::rc::Rc::new(std::cell::Cell::new(None));
+    let (fem_spoil, sph_spoil) = (spoil.clone(), spoil.clone());
+    let (fem_applied, sph_applied) = (applied.clone(), applied.clone());
+    let (mut fem, mut sph) = (fem, sph);
+    let (mut fem_step, mut sph_step) = (0u64, 0u64);
+    let failed = |node: &str, message: String| LinkError::Failed {
+        node: node.into(),
+        message,
+    };
+    let mut fem_link = InProcess::new(mesh, move |cmd: &StepCommand| {
+        let mut state = fem.handle(cmd).map_err(|e| failed("fem-node", e.to_string()))?;
+        if let (Some(s), Spoil::Fem { step, how }) = (state.as_mut(), &fem_spoil) {
+            if *step == fem_step {
+                fem_applied.set(spoil_fem(s, how).or(fem_applied.get()));
+            }
+        }
+        fem_step += 1;
+        Ok(state)
+    });
+    let mut sph_link = InProcess::new(setup, move |cmd: &StepCommand| {
+        let mut state = sph.handle(cmd).map_err(|e| failed("sph-node", e.to_string()))?;
+        if let (Some(s), Spoil::Sph { step, how }) = (state.as_mut(), &sph_spoil) {
+            if *step == sph_step {
+                sph_applied.set(spoil_sph(s, particles, how).or(sph_applied.get()));
+            }
+        }
+        sph_step += 1;
+        Ok(state)
+    });
+    let out = out_dir();
+    let info = RunInfo {
+        run_id: "fuzz".into(),
+        mode: "in-process".into(),
+        out: out.clone(),
+    };
+    let nodes = Nodes {
+        fem: Some(&mut fem_link),
+        sph: Some(&mut sph_link),
+    };
+    let outcome = coordinator::run(&scene, nodes, &info, &mut |_| Control::Continue(()));
+    let _ = std::fs::remove_dir_all(&out);
+    let field = field.or(applied.get());
+    (outcome.summary.status, outcome.summary.message, field)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// The broker's side: every spoilt registration or answer ends the run `failed` (or `unstable` for a NaN or an
+    /// infinity in a state) with a message that names the node, the message and the field; none panics or hangs.
+    #[test]
+    fn the_broker_refuses_every_inconsistent_message_naming_its_field(spoil in spoils()) {
+        let (status, message, field) = run_spoilt(&spoil);
+        match field {
+            None => prop_assert_eq!(status, "ok", "{}", message),
+            Some(field) => {
+                prop_assert!(status == "failed" || status == "unstable", "{status}: {message}");
+                prop_assert!(message.contains("sent an unusable message"), "{message}");
+                let node = match spoil {
+                    Spoil::Mesh(_) | Spoil::Fem { .. } => "fem-node",
+                    Spoil::Setup(_) | Spoil::Sph { .. } => "sph-node",
+                };
+                prop_assert!(message.contains(node), "{node} not in: {message}");
+                prop_assert!(message.contains(&format!(" {field}")), "field `{field}` not in: {message}");
+            }
+        }
+    }
+}
+
+/// A command the node cannot use: `(what it spoils, the field named)`.
+fn bad_commands(count: u32, max_dt: f64) -> Vec<(StepCommand, &'static str)> {
+    let fine = |id: u32| Correction {
+        id,
+        dx: [1e-6, 0.0],
+        dv: [0.0, 1e-3],
+    };
+    let base = StepCommand {
+        dt: max_dt,
+        corrections: vec![fine(0), fine(count - 1)],
+        roi: None,
+        want_interface: true,
+        want_snapshot: false,
+        stop: false,
+    };
+    let with = |f: &dyn Fn(&mut StepCommand)| {
+        let mut c = base.clone();
+        f(&mut c);
+        c
+    };
+    vec![
+        (with(&|c| c.corrections.push(fine(count))), "corrections.id"),
+        (with(&|c| c.corrections.push(fine(u32::MAX))), "corrections.id"),
+        (with(&|c| c.corrections[1].dx[0] = f64::NAN), "corrections.dx"),
+        (with(&|c| c.corrections[0].dv[1] = f64::INFINITY), "corrections.dv"),
+        (with(&|c| c.dt = f64::NAN), "dt"),
+        (with(&|c| c.dt = -1e-4), "dt"),
+        // A step of 1e300 s made the node sub-step for ever.
+        (with(&|c| c.dt = 1e300), "dt"),
+        (with(&|c| c.roi = Some([0.0, f64::NAN, 1.0, 1.0])), "roi"),
+        // A huge list whose last entry is bad: nothing of it may be applied.
+        (
+            with(&|c| {
+                c.corrections = (0..200_000).map(|i| fine(i % count)).collect();
+                c.corrections.push(fine(count + 7));
+            }),
+            "corrections.id",
+        ),
+        (
+            with(&|c| {
+                c.stop = true;
+                c.corrections.push(fine(count));
+            }),
+            "corrections.id",
+        ),
+    ]
+}
+
+/// The nodes' side: a command with an unknown id, a non-finite number, a step out of range or a huge list with one bad
+/// entry is an error naming the field, and the node's state (its checkpoint bytes) is unchanged.
+#[test]
+fn both_nodes_refuse_an_unusable_command_and_apply_none_of_it() {
+    let scene = scene();
+    let max_dt = scene.scene.coupling.max_dt;
+    let mut fem = FemCore::new(&scene.scene).expect("fem core");
+    let mut sph = SphCore::new(&scene.scene).expect("sph core");
+    let first = StepCommand {
+        dt: 0.0,
+        corrections: Vec::new(),
+        roi: None,
+        want_interface: true,
+        want_snapshot: true,
+        stop: false,
+    };
+    fem.handle(&first).expect("step 0");
+    sph.handle(&first).expect("step 0");
+    let nodes = fem.mesh().nodes.len() as u32;
+    for (cmd, field) in bad_commands(nodes, max_dt) {
+        let before = fem.checkpoint();
+        let e = fem.handle(&cmd).expect_err(field).to_string();
+        assert!(
+            e.contains(&format!("broker/fem {field}")),
+            "fem-node: `{field}` not in: {e}"
+        );
+        assert_eq!(
+            fem.checkpoint(),
+            before,
+            "fem-node applied part of a refused command ({field})"
+        );
+    }
+    let particles = sph.setup().particles;
+    for (cmd, field) in bad_commands(particles, max_dt) {
+        let before = sph.checkpoint();
+        let e = sph.handle(&cmd).expect_err(field).to_string();
+        assert!(
+            e.contains(&format!("broker/sph {field}")),
+            "sph-node: `{field}` not in: {e}"
+        );
+        assert_eq!(
+            sph.checkpoint(),
+            before,
+            "sph-node applied part of a refused command ({field})"
+        );
+    }
+    // The same commands made legal are taken: the refusals above were for the spoilt field, not the command.
+    let legal = StepCommand {
+        corrections: vec![Correction {
+            id: nodes - 1,
+            dx: [0.0; 2],
+            dv: [0.0; 2],
+        }],
+        dt: max_dt,
+        ..first.clone()
+    };
+    assert!(fem.handle(&legal).expect("a legal command").is_some());
+    let legal = StepCommand {
+        corrections: vec![Correction {
+            id: particles - 1,
+            dx: [0.0; 2],
+            dv: [0.0; 2],
+        }],
+        ..legal
+    };
+    assert!(sph.handle(&legal).expect("a legal command").is_some());
+}

@@ -1,0 +1,568 @@
+//! The contents of a well-framed message checked before anything uses them (`docs/PROTOCOL.md` §7, "Contents").
+//!
+//! The codec guarantees a message has the right layout, version, run and step; it cannot know that a segment names
+//! a node the mesh has, that two arrays meant to run side by side have the same length, or that a position is a
+//! number. Each incoming message type has one check here, run by its receiver right where it takes the message in,
+//! so that no later code indexes wire data unchecked. An error names the message, the field, the index and the
+//! value.
+
+use std::fmt;
+
+use crate::messages::{
+    Correction, FemMesh, FemSnapshot, FemState, Segment, SphSetup, SphSnapshot, SphState, StepCommand,
+};
+
+/// What makes a message unusable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Ids out of range, lengths that disagree, impossible parameters.
+    Inconsistent,
+    /// A NaN or an infinity where a state holds numbers: the sender blew up.
+    NonFinite,
+}
+
+/// A message whose contents cannot be used: `fem/mesh cells[12][2] = 999: node id out of range (480 nodes)`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{message} {field}{} = {value}: {problem}", Index(index))]
+pub struct Invalid {
+    /// The message (its topic, e.g. `fem/mesh`).
+    pub message: &'static str,
+    /// The field.
+    pub field: &'static str,
+    /// The index within the field, outermost first (empty for a scalar or a whole array).
+    pub index: Vec<usize>,
+    /// The offending value, as text.
+    pub value: String,
+    /// What is wrong with it.
+    pub problem: String,
+    /// Inconsistent, or a non-finite number.
+    pub kind: Kind,
+}
+
+impl Invalid {
+    /// True when the message holds a NaN or an infinity where a state holds numbers: the sender blew up.
+    pub fn is_non_finite(&self) -> bool {
+        self.kind == Kind::NonFinite
+    }
+}
+
+struct Index<'a>(&'a [usize]);
+
+impl fmt::Display for Index<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.iter().try_for_each(|i| write!(f, "[{i}]"))
+    }
+}
+
+/// `Ok` or the first problem found.
+pub type Result<T = ()> = std::result::Result<T, Invalid>;
+
+/// The checks of one message, all naming it.
+#[derive(Clone, Copy)]
+struct Check(&'static str);
+
+impl Check {
+    fn fail(
+        self,
+        field: &'static str,
+        index: &[usize],
+        value: impl fmt::Display,
+        problem: impl Into<String>,
+    ) -> Invalid {
+        Invalid {
+            message: self.0,
+            field,
+            index: index.to_vec(),
+            value: value.to_string(),
+            problem: problem.into(),
+            kind: Kind::Inconsistent,
+        }
+    }
+
+    /// `field` must hold `want` entries, one per `per`.
+    fn len(self, field: &'static str, got: usize, want: usize, per: &str) -> Result {
+        if got == want {
+            Ok(())
+        } else {
+            Err(self.fail(
+                field,
+                &[],
+                format!("{got} entries"),
+                format!("one per {per} expected: {want}"),
+            ))
+        }
+    }
+
+    fn finite(self, field: &'static str, index: &[usize], v: f64) -> Result {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(Invalid {
+                kind: Kind::NonFinite,
+                ..self.fail(field, index, format!("{v:?}"), "not a finite number")
+            })
+        }
+    }
+
+    fn points<const N: usize>(self, field: &'static str, xs: &[[f64; N]]) -> Result {
+        for (i, x) in xs.iter().enumerate() {
+            for (k, v) in x.iter().enumerate() {
+                self.finite(field, &[i, k], *v)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn values(self, field: &'static str, xs: &[f64]) -> Result {
+        xs.iter()
+            .enumerate()
+            .try_for_each(|(i, v)| self.finite(field, &[i], *v))
+    }
+
+    /// A finite number > 0 (masses, densities, lengths).
+    fn positive(self, field: &'static str, index: &[usize], v: f64) -> Result {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(field, index, format!("{v:?}"), "must be a finite number > 0"))
+        }
+    }
+
+    /// A time step: > 0 and not NaN (an infinite stable step means "no limit").
+    fn step(self, field: &'static str, v: f64) -> Result {
+        if v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(field, &[], format!("{v:?}"), "a stable step must be > 0"))
+        }
+    }
+
+    /// Seconds of computation: finite and ≥ 0.
+    fn seconds(self, field: &'static str, v: f64) -> Result {
+        if v.is_finite() && v >= 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(field, &[], format!("{v:?}"), "must be a finite number ≥ 0"))
+        }
+    }
+
+    fn id(self, field: &'static str, index: &[usize], id: u32, count: usize, what: &str) -> Result {
+        if (id as usize) < count {
+            Ok(())
+        } else {
+            Err(self.fail(field, index, id, format!("out of range ({count} {what})")))
+        }
+    }
+}
+
+impl FemMesh {
+    /// Check the mesh a structure node registered (topic `fem/mesh`).
+    pub fn validate(&self) -> Result {
+        let c = Check("fem/mesh");
+        let (nodes, solids) = (self.nodes.len(), self.solid_names.len());
+        if nodes == 0 {
+            return Err(c.fail("nodes", &[], "0 entries", "a structure node needs nodes"));
+        }
+        if solids == 0 {
+            return Err(c.fail("solid_names", &[], "0 entries", "a structure node needs a solid"));
+        }
+        c.points("nodes", &self.nodes)?;
+        c.len("masses", self.masses.len(), nodes, "node")?;
+        for (i, m) in self.masses.iter().enumerate() {
+            c.positive("masses", &[i], *m)?;
+        }
+        c.len("node_solid", self.node_solid.len(), nodes, "node")?;
+        for (i, s) in self.node_solid.iter().enumerate() {
+            c.id("node_solid", &[i], *s, solids, "solids")?;
+        }
+        c.len("cell_solid", self.cell_solid.len(), self.cells.len(), "cell")?;
+        for (e, cell) in self.cells.iter().enumerate() {
+            if !(3..=4).contains(&cell.len()) {
+                return Err(c.fail(
+                    "cells",
+                    &[e],
+                    format!("{} node ids", cell.len()),
+                    "a cell has 3 or 4 nodes",
+                ));
+            }
+            for (k, id) in cell.iter().enumerate() {
+                c.id("cells", &[e, k], *id, nodes, "nodes")?;
+            }
+        }
+        for (e, s) in self.cell_solid.iter().enumerate() {
+            c.id("cell_solid", &[e], *s, solids, "solids")?;
+        }
+        for (i, Segment { a, b }) in self.interface.iter().enumerate() {
+            c.id("interface", &[i, 0], *a, nodes, "nodes")?;
+            c.id("interface", &[i, 1], *b, nodes, "nodes")?;
+            if a == b {
+                return Err(c.fail(
+                    "interface",
+                    &[i],
+                    format!("{a}→{b}"),
+                    "a segment joins two different nodes",
+                ));
+            }
+        }
+        for (i, id) in self.fixed.iter().enumerate() {
+            c.id("fixed", &[i], *id, nodes, "nodes")?;
+        }
+        c.positive("dt_stable", &[], self.dt_stable)
+    }
+}
+
+/// What the broker asked a node for in a step, which its answer must match.
+#[derive(Clone, Copy, Debug)]
+pub struct Asked<'a> {
+    /// The interface state: for the structure, exactly the mesh's interface nodes; for the fluid, the particles
+    /// inside the region of interest.
+    pub interface: bool,
+    /// A full snapshot (an output time).
+    pub snapshot: bool,
+    /// For the structure: the ids of the mesh's interface nodes ([`FemMesh::interface_nodes`]).
+    pub interface_ids: &'a [u32],
+}
+
+impl FemState {
+    /// Check a structure node's answer (topic `fem/state`) against its mesh and what it was asked for.
+    pub fn validate(&self, mesh: &FemMesh, asked: Asked<'_>) -> Result {
+        let c = Check("fem/state");
+        if asked.interface || !self.ids.is_empty() {
+            let want = asked.interface_ids;
+            c.len("ids", self.ids.len(), want.len(), "interface node of the mesh")?;
+            if let Some(k) = (0..want.len()).find(|&k| self.ids[k] != want[k]) {
+                return Err(c.fail(
+                    "ids",
+                    &[k],
+                    self.ids[k],
+                    format!("the mesh's interface node {k} is node {}", want[k]),
+                ));
+            }
+        }
+        c.len("x", self.x.len(), self.ids.len(), "id")?;
+        c.len("v", self.v.len(), self.ids.len(), "id")?;
+        c.points("x", &self.x)?;
+        c.points("v", &self.v)?;
+        c.step("dt_stable", self.dt_stable)?;
+        c.seconds("compute_seconds", self.compute_seconds)?;
+        match &self.snapshot {
+            Some(s) => s.validate(mesh),
+            None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
+            None => Ok(()),
+        }
+    }
+}
+
+impl FemSnapshot {
+    /// Check a structure snapshot against the mesh it is of.
+    pub fn validate(&self, mesh: &FemMesh) -> Result {
+        let c = Check("fem/state snapshot");
+        c.len("x", self.x.len(), mesh.nodes.len(), "node")?;
+        c.len("v", self.v.len(), mesh.nodes.len(), "node")?;
+        c.len("stress", self.stress.len(), mesh.cells.len(), "cell")?;
+        c.len("energies", self.energies.len(), mesh.solid_names.len(), "solid")?;
+        c.points("x", &self.x)?;
+        c.points("v", &self.v)?;
+        c.points("stress", &self.stress)?;
+        let energies: Vec<[f64; 3]> = self
+            .energies
+            .iter()
+            .map(|e| [e.kinetic, e.strain, e.potential])
+            .collect();
+        c.points("energies", &energies)
+    }
+}
+
+impl SphSetup {
+    /// Check what a fluid node registered with (topic `sph/setup`).
+    pub fn validate(&self) -> Result {
+        let c = Check("sph/setup");
+        c.positive("spacing", &[], self.spacing)?;
+        c.positive("h", &[], self.h)?;
+        c.positive("density", &[], self.density)?;
+        c.points("walls", &self.walls)?;
+        c.step("dt_stable", self.dt_stable)
+    }
+}
+
+impl SphState {
+    /// Check a fluid node's answer (topic `sph/state`) against its registration and what it was asked for.
+    pub fn validate(&self, setup: &SphSetup, asked: Asked<'_>) -> Result {
+        let c = Check("sph/state");
+        let n = setup.particles as usize;
+        let mut last = None;
+        for (k, &id) in self.ids.iter().enumerate() {
+            c.id("ids", &[k], id, n, "particles")?;
+            if last.is_some_and(|l| id <= l) {
+                return Err(c.fail("ids", &[k], id, "ids must be ascending, each once"));
+            }
+            last = Some(id);
+        }
+        c.len("x", self.x.len(), self.ids.len(), "id")?;
+        c.len("v", self.v.len(), self.ids.len(), "id")?;
+        c.len("m", self.m.len(), self.ids.len(), "id")?;
+        c.points("x", &self.x)?;
+        c.points("v", &self.v)?;
+        for (k, m) in self.m.iter().enumerate() {
+            c.positive("m", &[k], *m)?;
+        }
+        c.step("dt_stable", self.dt_stable)?;
+        c.seconds("compute_seconds", self.compute_seconds)?;
+        match &self.snapshot {
+            Some(s) => s.validate(setup),
+            None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
+            None => Ok(()),
+        }
+    }
+}
+
+impl SphSnapshot {
+    /// Check a fluid snapshot against the registration it belongs to.
+    pub fn validate(&self, setup: &SphSetup) -> Result {
+        let c = Check("sph/state snapshot");
+        let n = setup.particles as usize;
+        for (field, len) in [
+            ("x", self.x.len()),
+            ("v", self.v.len()),
+            ("rho", self.rho.len()),
+            ("p", self.p.len()),
+            ("m", self.m.len()),
+        ] {
+            c.len(field, len, n, "fluid particle")?;
+        }
+        c.len("wall_p", self.wall_p.len(), setup.walls.len(), "wall particle")?;
+        c.points("x", &self.x)?;
+        c.points("v", &self.v)?;
+        c.values("p", &self.p)?;
+        c.values("wall_p", &self.wall_p)?;
+        for (k, rho) in self.rho.iter().enumerate() {
+            c.finite("rho", &[k], *rho)?;
+            c.positive("rho", &[k], *rho)?;
+        }
+        for (k, m) in self.m.iter().enumerate() {
+            c.positive("m", &[k], *m)?;
+        }
+        Ok(())
+    }
+}
+
+impl StepCommand {
+    /// Check a command (topics `broker/fem`, `broker/sph`) before a node applies any of it: a step no longer
+    /// than the scene's `coupling.max_dt`, a region of interest of numbers, and corrections to the node's
+    /// `count` nodes or particles. `message` names the topic.
+    pub fn validate(&self, message: &'static str, count: usize, max_dt: f64) -> Result {
+        let c = Check(message);
+        // The broker lands on output times within 1e-9 of a step (coordinator LANDING): allow that much.
+        if !(self.dt >= 0.0 && self.dt <= max_dt * (1.0 + 1e-6)) {
+            return Err(c.fail(
+                "dt",
+                &[],
+                format!("{:?}", self.dt),
+                format!("a step is between 0 and coupling.max_dt = {max_dt:?} s"),
+            ));
+        }
+        if let Some(roi) = &self.roi {
+            c.points("roi", std::slice::from_ref(roi))?;
+        }
+        validate_corrections(c, &self.corrections, count)
+    }
+}
+
+fn validate_corrections(c: Check, corrections: &[Correction], count: usize) -> Result {
+    for (k, corr) in corrections.iter().enumerate() {
+        c.id("corrections.id", &[k], corr.id, count, "ids")?;
+        for d in 0..2 {
+            c.finite("corrections.dx", &[k, d], corr.dx[d])?;
+            c.finite("corrections.dv", &[k, d], corr.dv[d])?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh() -> FemMesh {
+        FemMesh {
+            solid_names: vec!["plate".into()],
+            nodes: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            masses: vec![0.25; 4],
+            node_solid: vec![0; 4],
+            cells: vec![vec![0, 1, 2, 3]],
+            cell_solid: vec![0],
+            interface: vec![
+                Segment { a: 0, b: 1 },
+                Segment { a: 1, b: 2 },
+                Segment { a: 2, b: 3 },
+                Segment { a: 3, b: 0 },
+            ],
+            fixed: vec![0, 1],
+            dt_stable: 1e-4,
+        }
+    }
+
+    #[test]
+    fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
+        assert_eq!(mesh().validate(), Ok(()));
+        type Spoil = fn(&mut FemMesh);
+        let cases: Vec<(Spoil, &str)> = vec![
+            (
+                |m| m.interface[2].b = 4,
+                "fem/mesh interface[2][1] = 4: out of range (4 nodes)",
+            ),
+            (
+                |m| m.masses.truncate(3),
+                "fem/mesh masses = 3 entries: one per node expected: 4",
+            ),
+            (
+                |m| m.masses[1] = -1.0,
+                "fem/mesh masses[1] = -1.0: must be a finite number > 0",
+            ),
+            (
+                |m| m.nodes[3][1] = f64::NAN,
+                "fem/mesh nodes[3][1] = NaN: not a finite number",
+            ),
+            (
+                |m| m.cells[0][3] = 7,
+                "fem/mesh cells[0][3] = 7: out of range (4 nodes)",
+            ),
+            (
+                |m| m.node_solid[2] = 1,
+                "fem/mesh node_solid[2] = 1: out of range (1 solids)",
+            ),
+            (
+                |m| m.cell_solid[0] = 3,
+                "fem/mesh cell_solid[0] = 3: out of range (1 solids)",
+            ),
+            (|m| m.fixed.push(9), "fem/mesh fixed[2] = 9: out of range (4 nodes)"),
+            (
+                |m| m.dt_stable = 0.0,
+                "fem/mesh dt_stable = 0.0: must be a finite number > 0",
+            ),
+            (
+                |m| m.dt_stable = f64::NAN,
+                "fem/mesh dt_stable = NaN: must be a finite number > 0",
+            ),
+        ];
+        for (spoil, want) in cases {
+            let mut m = mesh();
+            spoil(&mut m);
+            assert_eq!(m.validate().unwrap_err().to_string(), want);
+        }
+    }
+
+    #[test]
+    fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
+        let m = mesh();
+        let ids = m.interface_nodes();
+        let asked = Asked {
+            interface: true,
+            snapshot: false,
+            interface_ids: &ids,
+        };
+        let state = FemState {
+            ids: ids.clone(),
+            x: m.nodes.clone(),
+            v: vec![[0.0; 2]; 4],
+            substeps: 1,
+            dt_stable: 1e-4,
+            compute_seconds: 0.0,
+            snapshot: None,
+        };
+        assert_eq!(state.validate(&m, asked), Ok(()));
+        let mut wrong = state.clone();
+        wrong.ids[2] = 168;
+        // The message the broker gave before named two equal counts ("reported 4 …, the mesh has 4").
+        assert_eq!(
+            wrong.validate(&m, asked).unwrap_err().to_string(),
+            "fem/state ids[2] = 168: the mesh's interface node 2 is node 2"
+        );
+        let mut nan = state.clone();
+        nan.v[1][0] = f64::INFINITY;
+        let e = nan.validate(&m, asked).unwrap_err();
+        assert!(e.is_non_finite());
+        assert_eq!(e.to_string(), "fem/state v[1][0] = inf: not a finite number");
+        let no_snapshot = Asked {
+            snapshot: true,
+            ..asked
+        };
+        assert_eq!(
+            state.validate(&m, no_snapshot).unwrap_err().to_string(),
+            "fem/state snapshot = none: asked for at an output time"
+        );
+    }
+
+    #[test]
+    fn fluid_ids_must_be_in_range_ascending_and_once() {
+        let setup = SphSetup {
+            particles: 3,
+            spacing: 0.01,
+            h: 0.013,
+            density: 1000.0,
+            walls: vec![],
+            dt_stable: 1e-4,
+        };
+        let asked = Asked {
+            interface: true,
+            snapshot: false,
+            interface_ids: &[],
+        };
+        let state = |ids: Vec<u32>| SphState {
+            x: vec![[0.0; 2]; ids.len()],
+            v: vec![[0.0; 2]; ids.len()],
+            m: vec![0.1; ids.len()],
+            ids,
+            substeps: 1,
+            dt_stable: 1e-4,
+            compute_seconds: 0.0,
+            snapshot: None,
+        };
+        assert_eq!(state(vec![0, 2]).validate(&setup, asked), Ok(()));
+        assert_eq!(
+            state(vec![0, 3]).validate(&setup, asked).unwrap_err().to_string(),
+            "sph/state ids[1] = 3: out of range (3 particles)"
+        );
+        assert_eq!(
+            state(vec![2, 2]).validate(&setup, asked).unwrap_err().to_string(),
+            "sph/state ids[1] = 2: ids must be ascending, each once"
+        );
+        let mut zero_dt = state(vec![1]);
+        zero_dt.dt_stable = 0.0;
+        assert_eq!(
+            zero_dt.validate(&setup, asked).unwrap_err().to_string(),
+            "sph/state dt_stable = 0.0: a stable step must be > 0"
+        );
+    }
+
+    #[test]
+    fn a_command_longer_than_max_dt_or_for_an_unknown_id_is_refused() {
+        let cmd = StepCommand {
+            dt: 1e-4,
+            corrections: vec![Correction {
+                id: 3,
+                dx: [0.0; 2],
+                dv: [1.0, 0.0],
+            }],
+            roi: None,
+            want_interface: true,
+            want_snapshot: false,
+            stop: false,
+        };
+        assert_eq!(cmd.validate("broker/fem", 4, 1e-4), Ok(()));
+        assert_eq!(
+            cmd.validate("broker/fem", 3, 1e-4).unwrap_err().to_string(),
+            "broker/fem corrections.id[0] = 3: out of range (3 ids)"
+        );
+        let long = StepCommand {
+            dt: 1e300,
+            ..cmd.clone()
+        };
+        assert_eq!(
+            long.validate("broker/sph", 4, 1e-4).unwrap_err().to_string(),
+            "broker/sph dt = 1e300: a step is between 0 and coupling.max_dt = 0.0001 s"
+        );
+        let nan = StepCommand { dt: f64::NAN, ..cmd };
+        assert!(nan.validate("broker/sph", 4, 1e-4).is_err());
+    }
+}
