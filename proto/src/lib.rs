@@ -5,7 +5,9 @@
 pub mod envelope;
 pub mod keys;
 pub mod messages;
+pub mod overlap;
 pub mod scene;
 pub mod session;
+pub mod sizing;
 
 pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

@@ -2,9 +2,13 @@
 //!
 //! Every user error is a [`SceneError`]: one line naming the file, the dotted key and the problem.
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+use crate::overlap;
+use crate::sizing::Sizing;
 
 /// The scene format version this build reads.
 pub const SCENE_VERSION: u32 = 1;
@@ -298,6 +302,28 @@ impl SolidSpec {
             .flat_map(|j| (0..nx).map(move |i| (i, j)))
             .map(|(i, j)| self.grid_node(i, j))
             .collect()
+    }
+
+    /// Whether a grid node lies in `b` (bounds included), found per axis without listing the nodes: the grid is
+    /// the product of two rows of coordinates, each increasing with its index (a binary search for the first at or
+    /// above the box's lower bound).
+    pub fn has_node_in(&self, b: &BoxSpec) -> bool {
+        let n = self.grid_size();
+        (0..2).all(|k| {
+            let at = |i: usize| {
+                if k == 0 {
+                    self.grid_node(i, 0)[0]
+                } else {
+                    self.grid_node(0, i)[1]
+                }
+            };
+            let (mut lo, mut hi) = (0, n[k]);
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                (lo, hi) = if at(mid) < b.min[k] { (mid + 1, hi) } else { (lo, mid) };
+            }
+            lo < n[k] && at(lo) <= b.max[k]
+        })
     }
 
     /// Number of elements the mesh will have.
@@ -876,6 +902,16 @@ impl Scene {
             || "run.name".into(),
             || "must not be empty".into(),
         )?;
+        check(
+            self.fluid.is_some() || self.walls.is_empty(),
+            || "wall".into(),
+            || "walls hold water: a scene with [[wall]] needs a [fluid]".into(),
+        )?;
+        check(
+            self.fluid.is_some() || !self.solids.is_empty(),
+            || "solid".into(),
+            || "nothing to run: the scene has no [[solid]] and no [fluid]".into(),
+        )?;
         finite_positive("run.end_time", self.run.end_time)?;
         finite_positive("run.output_interval", self.run.output_interval)?;
         check(
@@ -914,10 +950,28 @@ impl Scene {
                 },
             )?;
         }
+        let mut solids = HashSet::with_capacity(self.solids.len());
         for (s, solid) in self.solids.iter().enumerate() {
-            self.validate_solid(s, solid)?;
+            Self::validate_solid(s, solid)?;
+            check(
+                solids.insert(solid.name.as_str()),
+                || format!("solid[{s}].name"),
+                || format!("`{}` is used by another solid", solid.name),
+            )?;
         }
-        let mut names: Vec<&str> = Vec::new();
+        let rects: Vec<overlap::Rect> = self.solids.iter().map(|s| (s.min, s.max)).collect();
+        if let Some((a, b)) = overlap::first_overlap(&rects) {
+            let (first, second) = (&self.solids[a], &self.solids[b]);
+            return Err((
+                format!("solid[{b}]"),
+                format!(
+                    "`{}` (min {:?} max {:?}) overlaps solid[{a}] `{}` (min {:?} max {:?}): solids may touch along \
+                     an edge but not share area",
+                    second.name, second.min, second.max, first.name, first.min, first.max
+                ),
+            ));
+        }
+        let mut names = HashSet::with_capacity(self.probes.len());
         for (p, probe) in self.probes.iter().enumerate() {
             let key = |k: &str| format!("probe[{p}].{k}");
             check(
@@ -926,14 +980,24 @@ impl Scene {
                 || "must be non-empty and contain no comma".into(),
             )?;
             check(
-                !names.contains(&probe.name.as_str()),
+                names.insert(probe.name.as_str()),
                 || key("name"),
                 || format!("`{}` is used by another probe", probe.name),
             )?;
-            names.push(&probe.name);
+            let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
+            check(
+                probe.point.is_none_or(|p| finite(&p)),
+                || key("point"),
+                || format!("must be finite, got {:?}", probe.point.unwrap_or_default()),
+            )?;
+            check(
+                probe.x_max.is_none_or(f64::is_finite),
+                || key("x_max"),
+                || format!("must be finite, got {}", probe.x_max.unwrap_or_default()),
+            )?;
             if let Some(name) = &probe.solid {
                 check(
-                    self.solids.iter().any(|s| &s.name == name),
+                    solids.contains(name.as_str()),
                     || key("solid"),
                     || format!("no solid named `{name}` (solids: {})", self.solid_names()),
                 )?;
@@ -998,9 +1062,17 @@ impl Scene {
             }
             if let Some(r) = &probe.reference {
                 finite_positive(&key("reference.scale"), r.scale.abs())?;
+                for (k, v) in [("t_scale", r.t_scale), ("t_offset", r.t_offset)] {
+                    check(
+                        v.is_finite(),
+                        || key(&format!("reference.{k}")),
+                        || format!("must be finite, got {v}"),
+                    )?;
+                }
             }
         }
-        Ok(())
+        // Last: the counts are meaningful once every number above is known to be finite and positive.
+        Sizing::of(self).check_counts()
     }
 
     fn solid_names(&self) -> String {
@@ -1014,17 +1086,12 @@ impl Scene {
             .join(", ")
     }
 
-    fn validate_solid(&self, s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
+    fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
         let key = |k: &str| format!("solid[{s}].{k}");
         check(
             !solid.name.trim().is_empty(),
             || key("name"),
             || "must not be empty".into(),
-        )?;
-        check(
-            !self.solids[..s].iter().any(|o| o.name == solid.name),
-            || key("name"),
-            || format!("`{}` is used by another solid", solid.name),
         )?;
         for k in 0..2 {
             check(
@@ -1056,10 +1123,14 @@ impl Scene {
             || key("damping"),
             || format!("must be zero or positive, got {}", solid.damping),
         )?;
-        let nodes = solid.grid_nodes();
         for (f, b) in solid.fixed.iter().enumerate() {
             check(
-                nodes.iter().any(|&p| b.contains(p)),
+                b.min.iter().chain(&b.max).all(|v| v.is_finite()),
+                || key(&format!("fixed[{f}]")),
+                || format!("corners must be finite, got min {:?} max {:?}", b.min, b.max),
+            )?;
+            check(
+                solid.has_node_in(b),
                 || key(&format!("fixed[{f}]")),
                 || format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max),
             )?;
