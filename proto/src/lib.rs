@@ -6,6 +6,7 @@ pub mod envelope;
 pub mod keys;
 pub mod messages;
 pub mod overlap;
+mod overrides;
 pub mod scene;
 pub mod session;
 pub mod sizing;
