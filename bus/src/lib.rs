@@ -1,10 +1,12 @@
 //! The zenoh side of the co-simulation's processes, shared by every node binary and the broker: session
 //! settings (`session`), the loop a solver node runs to serve a run (`serve`), the live status every process
-//! answers queries with (`status`) and the catching of Ctrl-C (`interrupt`). Solver libraries never see it.
+//! answers queries with (`status`), the catching of Ctrl-C (`interrupt`) and the machine's available memory a scene
+//! is sized against (`memory`). Solver libraries never see it.
 #![warn(missing_docs)]
 
 pub mod cli;
 pub mod interrupt;
+pub mod memory;
 pub mod serve;
 pub mod session;
 pub mod status;

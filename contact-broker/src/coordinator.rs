@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::Context;
 
 use cosim_proto::messages::{FemMesh, FemState, SphSnapshot, SphState, StepCommand};
-use cosim_proto::scene::{LoadedScene, SceneError};
+use cosim_proto::scene::LoadedScene;
 use cosim_proto::validate::{Asked, Invalid};
 
 use crate::checkpoint::{self, BrokerState};
@@ -53,25 +53,6 @@ pub struct Outcome {
     pub summary: Summary,
     /// Set when the run did not finish.
     pub error: Option<anyhow::Error>,
-}
-
-/// Scenes this coordinator refuses up front, with the key that makes them meaningless.
-pub fn check_supported(scene: &LoadedScene) -> Result<(), SceneError> {
-    let refuse = |key: &str, message: &str| {
-        Err(SceneError {
-            file: scene.path.display().to_string(),
-            key: key.into(),
-            message: message.into(),
-        })
-    };
-    let s = &scene.scene;
-    if s.fluid.is_none() && !s.walls.is_empty() {
-        return refuse("wall", "walls hold water: a scene with [[wall]] needs a [fluid]");
-    }
-    if s.fluid.is_none() && s.solids.is_empty() {
-        return refuse("solid", "nothing to run: the scene has no [[solid]] and no [fluid]");
-    }
-    Ok(())
 }
 
 /// Steps closer than this fraction of `max_dt` to an output time land on it.

@@ -18,6 +18,7 @@ use cosim_bus::interrupt::Interrupt;
 use cosim_bus::status::{serve_status, Board};
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
+use cosim_proto::sizing::Part;
 
 /// The co-simulation's step coordinator and contact broker.
 #[derive(Parser, Debug)]
@@ -89,7 +90,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         args.run
     );
     let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
-    coordinator::check_supported(&scene)?;
+    let file = args.scene.display().to_string();
+    cosim_bus::memory::refuse_above(&scene.scene, Part::Broker, &file, cosim_bus::memory::available())?;
     checkpoint::check_interval(args.checkpoint_interval)?;
     let restart = match &args.restart {
         Some(dir) => Some(checkpoint::open(dir, &scene)?),

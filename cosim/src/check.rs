@@ -3,7 +3,9 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
+use cosim_bus::memory;
 use cosim_proto::scene::{self, DensityFilter};
+use cosim_proto::sizing::{bytes_text, Part, Sizing};
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -13,6 +15,10 @@ use crate::cli::CheckArgs;
 pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let loaded = scene::load(&args.scene, &args.set)?;
     let s = &loaded.scene;
+    // Sized from the scene alone, before the structure and the fluid are built below.
+    let sizing = Sizing::of(s);
+    let available = memory::available();
+    memory::refuse_above(s, Part::Run, &args.scene.display().to_string(), available)?;
     let (dt_fem, nodes, elements) = if s.solids.is_empty() {
         (None, 0, 0)
     } else {
@@ -57,6 +63,20 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "fem_substeps_per_step": substeps,
             "frames": frames,
             "probes": s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
+            // From the scene alone (proto::sizing): what `run` compares with the memory available.
+            "estimate": {
+                "fluid_particles": sizing.fluid_particles as u64,
+                "wall_particles": sizing.wall_particles as u64,
+                "grid_cells": sizing.grid_cells as u64,
+                "fem_nodes": sizing.fem_nodes as u64,
+                "fem_elements": sizing.fem_elements as u64,
+                "probe_samples": sizing.probe_samples as u64,
+                "memory_bytes": sizing.bytes(Part::Run) as u64,
+                "sph_node_bytes": sizing.bytes(Part::Fluid) as u64,
+                "fem_node_bytes": sizing.bytes(Part::Structure) as u64,
+                "broker_bytes": sizing.bytes(Part::Broker) as u64,
+                "available_bytes": available,
+            },
             // The corrections in force (§4.4), the per-solver defaults filled in.
             "corrections": s.fluid.as_ref().map(|f| serde_json::json!({
                 "density_filter": f.density_filter(),
@@ -117,6 +137,22 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
     }
     println!("  totals: {nodes} FE nodes, {elements} elements, {particles} particles (coupling steps are estimated from the initial stable step)");
+    // A node the scene does not start has no share.
+    let part = |p: Part, name: &str| (sizing.bytes(p) > 0.0).then(|| format!("{name} {}", bytes_text(sizing.bytes(p))));
+    let parts: Vec<String> = [
+        part(Part::Fluid, "sph-node"),
+        part(Part::Structure, "fem-node"),
+        part(Part::Broker, "contact-broker"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    println!(
+        "  memory: about {} at its peak ({}; estimated from the scene, processes mode), {} available",
+        bytes_text(sizing.bytes(Part::Run)),
+        parts.join(", "),
+        available.map_or("unknown".to_string(), |a| bytes_text(a as f64))
+    );
     for p in &s.probes {
         println!("  probe {}: {:?}", p.name, p.kind);
     }

@@ -10,6 +10,7 @@ use contact_broker::link::{FemLink, SphLink};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{self, LoadedScene};
+use cosim_proto::sizing::Part;
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -21,7 +22,9 @@ use crate::progress::Bar;
 /// Run a scene; `Err` only for bad input (exit 2), a failed run is exit 1 with one line on stderr.
 pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let scene = scene::load(&args.scene, &args.set)?;
-    coordinator::check_supported(&scene)?;
+    // Before anything is built or started: a scene too big for this machine is bad input, said with its key.
+    let file = args.scene.display().to_string();
+    cosim_bus::memory::refuse_above(&scene.scene, Part::Run, &file, cosim_bus::memory::available())?;
     let run_id = match &args.run_id {
         Some(id) if valid_run_id(id) => id.clone(),
         Some(id) => anyhow::bail!("--run-id `{id}`: use 1–64 letters, digits, - and _"),

@@ -2,9 +2,14 @@
 //!
 //! Every user error is a [`SceneError`]: one line naming the file, the dotted key and the problem.
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+use crate::overlap;
+use crate::overrides;
+use crate::sizing::Sizing;
 
 /// The scene format version this build reads.
 pub const SCENE_VERSION: u32 = 1;
@@ -300,6 +305,28 @@ impl SolidSpec {
             .collect()
     }
 
+    /// Whether a grid node lies in `b` (bounds included), found per axis without listing the nodes: the grid is
+    /// the product of two rows of coordinates, each increasing with its index (a binary search for the first at or
+    /// above the box's lower bound).
+    pub fn has_node_in(&self, b: &BoxSpec) -> bool {
+        let n = self.grid_size();
+        (0..2).all(|k| {
+            let at = |i: usize| {
+                if k == 0 {
+                    self.grid_node(i, 0)[0]
+                } else {
+                    self.grid_node(0, i)[1]
+                }
+            };
+            let (mut lo, mut hi) = (0, n[k]);
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                (lo, hi) = if at(mid) < b.min[k] { (mid + 1, hi) } else { (lo, mid) };
+            }
+            lo < n[k] && at(lo) <= b.max[k]
+        })
+    }
+
     /// Number of elements the mesh will have.
     pub fn element_count(&self) -> usize {
         let cells = self.divisions[0] as usize * self.divisions[1] as usize;
@@ -592,7 +619,7 @@ pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError
 pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
     let mut value: toml::Value = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
     for o in overrides {
-        apply_override(&mut value, o).map_err(|(key, msg)| SceneError::new(file, format!("--set {key}"), msg))?;
+        overrides::apply(&mut value, o).map_err(|(key, msg)| SceneError::new(file, format!("--set {key}"), msg))?;
     }
     let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
@@ -644,97 +671,6 @@ fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
         parent
     };
     (key, message.replace('\n', " "))
-}
-
-/// Apply one `key.path=value` override. Paths take `name`, `name[3]` or `name.3` segments; an array of tables
-/// with a single element may be addressed without an index.
-fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), (String, String)> {
-    let (path, raw) = assignment
-        .split_once('=')
-        .ok_or_else(|| (assignment.to_string(), "expected key.path=value".to_string()))?;
-    let path = path.trim();
-    let fail = |msg: String| (path.to_string(), msg);
-    let value = parse_value(raw.trim());
-    let mut segments = Vec::new();
-    for part in path.split('.') {
-        if part.is_empty() {
-            return Err(fail("empty segment in key path".into()));
-        }
-        match part.split_once('[') {
-            Some((name, rest)) => {
-                let index = rest
-                    .strip_suffix(']')
-                    .and_then(|i| i.parse::<usize>().ok())
-                    .ok_or_else(|| fail(format!("bad index in `{part}`")))?;
-                if !name.is_empty() {
-                    segments.push(Segment::Key(name.to_string()));
-                }
-                segments.push(Segment::Index(index));
-            }
-            None => match part.parse::<usize>() {
-                Ok(i) => segments.push(Segment::Index(i)),
-                Err(_) => segments.push(Segment::Key(part.to_string())),
-            },
-        }
-    }
-    let mut node = root;
-    let n = segments.len();
-    for (k, seg) in segments.into_iter().enumerate() {
-        let last = k + 1 == n;
-        // An array addressed by name alone: step into its only element.
-        let array_len = node.as_array().map(Vec::len);
-        if let (Segment::Key(_), Some(len)) = (&seg, array_len) {
-            if len != 1 {
-                return Err(fail(format!("is an array of {len} items; give an index")));
-            }
-            node = node.as_array_mut().and_then(|a| a.first_mut()).expect("one item");
-        }
-        node = match seg {
-            Segment::Key(name) => {
-                let table = node
-                    .as_table_mut()
-                    .ok_or_else(|| fail(format!("`{name}` is not inside a table")))?;
-                if last {
-                    table.insert(name, value);
-                    return Ok(());
-                }
-                table
-                    .entry(name)
-                    .or_insert_with(|| toml::Value::Table(toml::map::Map::new()))
-            }
-            Segment::Index(i) => {
-                let items = node
-                    .as_array_mut()
-                    .ok_or_else(|| fail(format!("[{i}] applied to a non-array")))?;
-                let len = items.len();
-                let item = items
-                    .get_mut(i)
-                    .ok_or_else(|| fail(format!("index {i} out of range ({len} items)")))?;
-                if last {
-                    *item = value;
-                    return Ok(());
-                }
-                item
-            }
-        };
-    }
-    Err(fail("empty key path".into()))
-}
-
-enum Segment {
-    Key(String),
-    Index(usize),
-}
-
-/// A TOML value if the text parses as one, else a bare string (so `--set fluid.solver=isph` works unquoted).
-fn parse_value(raw: &str) -> toml::Value {
-    #[derive(Deserialize)]
-    struct Holder {
-        v: toml::Value,
-    }
-    toml::from_str::<Holder>(&format!("v = {raw}"))
-        .map(|h| h.v)
-        .unwrap_or_else(|_| toml::Value::String(raw.to_string()))
 }
 
 type Invalid = (String, String);
@@ -876,6 +812,16 @@ impl Scene {
             || "run.name".into(),
             || "must not be empty".into(),
         )?;
+        check(
+            self.fluid.is_some() || self.walls.is_empty(),
+            || "wall".into(),
+            || "walls hold water: a scene with [[wall]] needs a [fluid]".into(),
+        )?;
+        check(
+            self.fluid.is_some() || !self.solids.is_empty(),
+            || "solid".into(),
+            || "nothing to run: the scene has no [[solid]] and no [fluid]".into(),
+        )?;
         finite_positive("run.end_time", self.run.end_time)?;
         finite_positive("run.output_interval", self.run.output_interval)?;
         check(
@@ -914,10 +860,28 @@ impl Scene {
                 },
             )?;
         }
+        let mut solids = HashSet::with_capacity(self.solids.len());
         for (s, solid) in self.solids.iter().enumerate() {
-            self.validate_solid(s, solid)?;
+            Self::validate_solid(s, solid)?;
+            check(
+                solids.insert(solid.name.as_str()),
+                || format!("solid[{s}].name"),
+                || format!("`{}` is used by another solid", solid.name),
+            )?;
         }
-        let mut names: Vec<&str> = Vec::new();
+        let rects: Vec<overlap::Rect> = self.solids.iter().map(|s| (s.min, s.max)).collect();
+        if let Some((a, b)) = overlap::first_overlap(&rects) {
+            let (first, second) = (&self.solids[a], &self.solids[b]);
+            return Err((
+                format!("solid[{b}]"),
+                format!(
+                    "`{}` (min {:?} max {:?}) overlaps solid[{a}] `{}` (min {:?} max {:?}): solids may touch along \
+                     an edge but not share area",
+                    second.name, second.min, second.max, first.name, first.min, first.max
+                ),
+            ));
+        }
+        let mut names = HashSet::with_capacity(self.probes.len());
         for (p, probe) in self.probes.iter().enumerate() {
             let key = |k: &str| format!("probe[{p}].{k}");
             check(
@@ -926,14 +890,24 @@ impl Scene {
                 || "must be non-empty and contain no comma".into(),
             )?;
             check(
-                !names.contains(&probe.name.as_str()),
+                names.insert(probe.name.as_str()),
                 || key("name"),
                 || format!("`{}` is used by another probe", probe.name),
             )?;
-            names.push(&probe.name);
+            let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
+            check(
+                probe.point.is_none_or(|p| finite(&p)),
+                || key("point"),
+                || format!("must be finite, got {:?}", probe.point.unwrap_or_default()),
+            )?;
+            check(
+                probe.x_max.is_none_or(f64::is_finite),
+                || key("x_max"),
+                || format!("must be finite, got {}", probe.x_max.unwrap_or_default()),
+            )?;
             if let Some(name) = &probe.solid {
                 check(
-                    self.solids.iter().any(|s| &s.name == name),
+                    solids.contains(name.as_str()),
                     || key("solid"),
                     || format!("no solid named `{name}` (solids: {})", self.solid_names()),
                 )?;
@@ -998,9 +972,17 @@ impl Scene {
             }
             if let Some(r) = &probe.reference {
                 finite_positive(&key("reference.scale"), r.scale.abs())?;
+                for (k, v) in [("t_scale", r.t_scale), ("t_offset", r.t_offset)] {
+                    check(
+                        v.is_finite(),
+                        || key(&format!("reference.{k}")),
+                        || format!("must be finite, got {v}"),
+                    )?;
+                }
             }
         }
-        Ok(())
+        // Last: the counts are meaningful once every number above is known to be finite and positive.
+        Sizing::of(self).check_counts()
     }
 
     fn solid_names(&self) -> String {
@@ -1014,17 +996,12 @@ impl Scene {
             .join(", ")
     }
 
-    fn validate_solid(&self, s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
+    fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
         let key = |k: &str| format!("solid[{s}].{k}");
         check(
             !solid.name.trim().is_empty(),
             || key("name"),
             || "must not be empty".into(),
-        )?;
-        check(
-            !self.solids[..s].iter().any(|o| o.name == solid.name),
-            || key("name"),
-            || format!("`{}` is used by another solid", solid.name),
         )?;
         for k in 0..2 {
             check(
@@ -1056,10 +1033,14 @@ impl Scene {
             || key("damping"),
             || format!("must be zero or positive, got {}", solid.damping),
         )?;
-        let nodes = solid.grid_nodes();
         for (f, b) in solid.fixed.iter().enumerate() {
             check(
-                nodes.iter().any(|&p| b.contains(p)),
+                b.min.iter().chain(&b.max).all(|v| v.is_finite()),
+                || key(&format!("fixed[{f}]")),
+                || format!("corners must be finite, got min {:?} max {:?}", b.min, b.max),
+            )?;
+            check(
+                solid.has_node_in(b),
                 || key(&format!("fixed[{f}]")),
                 || format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max),
             )?;
