@@ -231,3 +231,39 @@ fn a_still_tank_with_delta_sph_keeps_its_hydrostatic_state() {
         "plain moved {moved_plain}, corrected {moved}"
     );
 }
+
+/// `fluid.density_diffusion` is checked where the scene is read: δ in [0, 1], WCSPH only; absent it is 0 (off).
+#[test]
+fn the_option_is_validated_with_the_scene() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
+    let parse = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        cosim_proto::scene::parse("dam_break.toml", &text, &sets)
+    };
+    let scene = parse(&[]).expect("valid");
+    let fluid = scene.fluid.as_ref().unwrap();
+    assert_eq!(fluid.density_diffusion, 0.0);
+    let on = parse(&["fluid.density_diffusion=0.1"]).expect("valid");
+    assert_eq!(on.fluid.as_ref().unwrap().density_diffusion, 0.1);
+    assert_eq!(WcsphSolver::new(&on).unwrap().options().density_diffusion, 0.1);
+    for (sets, words) in [
+        (
+            &["fluid.density_diffusion=1.5"][..],
+            &["fluid.density_diffusion", "[0, 1]", "1.5"][..],
+        ),
+        (
+            &["fluid.density_diffusion=-0.1"][..],
+            &["fluid.density_diffusion", "-0.1"][..],
+        ),
+        (
+            &["fluid.density_diffusion=0.1", "fluid.solver=\"isph\""][..],
+            &["fluid.density_diffusion", "wcsph"][..],
+        ),
+    ] {
+        let err = parse(sets).expect_err("refused").to_string();
+        for w in words {
+            assert!(err.contains(w), "{sets:?}: `{err}` lacks `{w}`");
+        }
+        assert!(err.contains("dam_break.toml"), "{err}");
+    }
+}
