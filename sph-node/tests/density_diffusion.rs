@@ -109,7 +109,7 @@ fn the_corrected_term_vanishes_on_a_hydrostatic_lattice_and_the_plain_one_does_n
     );
 
     // The Tait hydrostatic state of the scenes (sph-node/src/setup.rs): the correction leaves the curvature of
-    // ρ(depth) only, second order (measured 1.2 % of the plain term's largest value).
+    // ρ(depth) only, second order (measured 2.7 % of the plain term's largest value).
     let tait = sph_node::eos::Tait::new(RHO0, c0);
     let rho: Vec<f64> = x.iter().map(|q| tait.density(RHO0 * G * (depth - q[1]))).collect();
     let corr_max = max_abs(rates(&corrected, &x, &rho, dx, &kernel));
