@@ -267,3 +267,62 @@ fn the_option_is_validated_with_the_scene() {
         assert!(err.contains("dam_break.toml"), "{err}");
     }
 }
+
+/// The solver adds D_i to the continuity rate: one short step of a block at rest with uneven densities, δ-SPH on
+/// against off, changes ρ by Δt D_i (the gather of the unit tests above), sign and factor included.
+#[test]
+fn the_solver_adds_the_term_to_the_continuity_rate() {
+    use sph_node::solver::{SphParams, WcsphOptions};
+    let (n, dx) = (10, 0.01);
+    let (h, c0) = (1.3 * dx, 20.0);
+    let x = lattice(n, n, dx);
+    let rho: Vec<f64> = x
+        .iter()
+        .map(|q| RHO0 * (1.0 + 0.005 * (q[0] * 300.0).sin() * (q[1] * 200.0).cos()))
+        .collect();
+    let params = SphParams {
+        rho0: RHO0,
+        dx,
+        h,
+        c0,
+        nu: 0.0,
+        gravity: [0.0, -G],
+        alpha: 0.0,
+        shepard_interval: None,
+        xsph: 0.0,
+        domain: cosim_proto::scene::BoxSpec {
+            min: [-1.0, -1.0],
+            max: [1.0, 1.0],
+        },
+    };
+    let state = sph_node::FluidState {
+        t: 0.0,
+        step: 0,
+        v: vec![[0.0; 2]; x.len()],
+        p: vec![0.0; x.len()],
+        m: vec![RHO0 * dx * dx; x.len()],
+        x: x.clone(),
+        rho: rho.clone(),
+    };
+    // Short enough that the second half-kick's D, at ρ + ½Δt D, is the first's to 1e-6 (at 1e-6 s they differ by
+    // 2e-4 of D).
+    let dt = 1e-8;
+    let stepped = |delta: f64| {
+        let walls = sph_node::WallParticles::default();
+        let mut s = WcsphSolver::from_particles(params.clone(), WcsphOptions::default(), state.clone(), walls).unwrap();
+        s.set_density_diffusion(delta, true);
+        s.step(dt).unwrap();
+        s.state().rho.clone()
+    };
+    let (on, off) = (stepped(DELTA), stepped(0.0));
+    let d = DensityDiffusion::new(DELTA, h, c0, RHO0, [0.0, -G]);
+    let expected = rates(&d, &x, &rho, dx, &CubicSpline::new(h));
+    let scale = max_abs(expected.iter().copied());
+    let worst = max_abs((0..x.len()).map(|i| (on[i] - off[i]) / dt - expected[i]));
+    eprintln!("solver: largest |D| {scale:.3e} kg/m3/s, largest difference to the gather {worst:.3e}");
+    assert!(scale > 1.0, "D {scale}");
+    assert!(
+        worst < 1e-5 * scale,
+        "solver against gather: {worst}, |D| up to {scale}"
+    );
+}
