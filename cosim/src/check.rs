@@ -83,6 +83,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
                 "density_filter_interval": f.density_filter_interval,
                 "xsph": f.xsph,
                 "apd": f.apd(),
+                "density_diffusion": f.density_diffusion,
             })),
         });
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -128,7 +129,15 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             DensityFilter::None => "no density filter".to_string(),
             other => format!("{other:?} density filter every {} steps", f.density_filter_interval),
         };
-        println!("  corrections: {filter}, XSPH eps = {}, APD beta = {}", f.xsph, f.apd());
+        let diffusion = match f.density_diffusion {
+            d if d > 0.0 => format!(", density diffusion delta = {d} (Fourtakas et al. 2019)"),
+            _ => String::new(),
+        };
+        println!(
+            "  corrections: {filter}, XSPH eps = {}, APD beta = {}{diffusion}",
+            f.xsph,
+            f.apd()
+        );
     }
     match (dt_fem, substeps) {
         (Some(d), Some(k)) => println!(

@@ -129,6 +129,11 @@ pub struct FluidSpec {
     /// where the shift is available but not yet the default (docs/CORRECTIONS.md).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub apd: Option<f64>,
+    /// δ of the δ-SPH density diffusion in the continuity equation (Molteni & Colagrossi 2009, with the hydrostatic
+    /// correction of Fourtakas et al. 2019; WCSPH only), in [0, 1]; 0, the default, disables it (0.1 is the usual
+    /// value). Not written to `scene.toml` when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub density_diffusion: f64,
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ppe_source: Option<PpeSourceKind>,
@@ -165,6 +170,10 @@ fn default_xsph() -> f64 {
 
 fn default_fluid_cfl() -> f64 {
     1.0
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn is_default_fluid_cfl(cfl: &f64) -> bool {
@@ -738,6 +747,21 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Res
         f.apd().is_finite() && (0.0..=1.0).contains(&f.apd()),
         || "fluid.apd".into(),
         || format!("must be in [0, 1], got {}", f.apd()),
+    )?;
+    check(
+        f.density_diffusion.is_finite() && (0.0..=1.0).contains(&f.density_diffusion),
+        || "fluid.density_diffusion".into(),
+        || {
+            format!(
+                "must be in [0, 1] (δ of δ-SPH; 0.1 is usual), got {}",
+                f.density_diffusion
+            )
+        },
+    )?;
+    check(
+        f.density_diffusion == 0.0 || f.solver == FluidSolver::Wcsph,
+        || "fluid.density_diffusion".into(),
+        || "applies to solver = \"wcsph\" only (ISPH takes its pressure from the Poisson equation)".into(),
     )?;
     if f.solver == FluidSolver::Isph {
         check(

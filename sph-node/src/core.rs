@@ -18,8 +18,9 @@ use crate::stability::EnergyGuard;
 
 /// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9). Version 2: the
 /// solvers carry `fluid.cfl`; 3: the WCSPH solver carries its wall boxes and wall-guard count; 4: the neighbour lists
-/// keep only the ∇W factor per pair (no r², no W), and the WCSPH scratch has two per-particle buffers (was six).
-const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 5);
+/// keep only the ∇W factor per pair (no r², no W), and the WCSPH scratch has two per-particle buffers (was six); 6: the
+/// WCSPH options carry the δ-SPH density diffusion.
+const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 6);
 
 /// The fluid solver the scene asks for.
 #[derive(Serialize, Deserialize)]

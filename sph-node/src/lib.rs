@@ -4,7 +4,8 @@
 //! * [`kernel`]: the 2D cubic spline kernel.
 //! * [`neighbors`]: cell-linked list and fixed-order neighbour lists (gathers).
 //! * [`eos`]: Tait equation of state.
-//! * [`wcsph`]: continuity Eq. (9), momentum Eq. (10), artificial viscosity Eq. (11), laminar viscosity Eq. (12).
+//! * [`wcsph`]: continuity Eq. (9), momentum Eq. (10), artificial viscosity Eq. (11), laminar viscosity Eq. (12);
+//!   optional δ-SPH density diffusion (Molteni & Colagrossi 2009, Fourtakas et al. 2019).
 //! * [`boundary`]: wall particles and the Adami et al. 2012 pressure extrapolation.
 //! * [`corrections`]: Shepard density filter and XSPH (§4.4).
 //! * [`time_step`], [`integrator`]: stable step and kick–drift–kick.

@@ -1,5 +1,6 @@
 //! [`WcsphSolver`]: the WCSPH pipeline of `DESIGN.md` §4.2 (Eqs. (9)–(12)) with Adami walls (§4.7), the Shepard
-//! or first-order MLS density filter, XSPH and APD (§4.4), advanced by kick–drift–kick.
+//! or first-order MLS density filter, XSPH and APD (§4.4), the optional δ-SPH density diffusion
+//! ([`crate::wcsph::density_diffusion`]), advanced by kick–drift–kick.
 //!
 //! The solver owns the serializable [`FluidState`] and [`WallParticles`], a working copy of the particles sorted by
 //! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the ∇W factor of each pair,
@@ -35,7 +36,7 @@ use crate::neighbors::{NeighborList, SortedCells};
 use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::time_step;
-use crate::wcsph::{continuity, momentum, MomentumParams};
+use crate::wcsph::{continuity, momentum, DensityDiffusion, MomentumParams};
 
 /// Resolved parameters of the fluid.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -73,6 +74,12 @@ pub struct WcsphOptions {
     pub apd: f64,
     /// Central body force a = −k x (k = Ω², Monaghan & Rafiee 2013 oscillating drop); 0 for scenes.
     pub central_force: f64,
+    /// δ of the δ-SPH density diffusion in the continuity equation (0: off; `fluid.density_diffusion`,
+    /// [`crate::wcsph::density_diffusion`]).
+    pub density_diffusion: f64,
+    /// The density diffusion leaves out the hydrostatic correction of Fourtakas et al. 2019 (plain Molteni &
+    /// Colagrossi 2009; tests and comparisons only, no scene key).
+    pub density_diffusion_uncorrected: bool,
 }
 
 /// The particles as the gathers see them: the fluid sorted by cell (slot k holds particle `ids[k]`), then the
@@ -222,6 +229,8 @@ impl WcsphSolver {
             // pressure (the δ+-SPH shift fights the cubic spline's pairing mode; docs/CORRECTIONS.md).
             apd: spec.apd(),
             central_force: 0.0,
+            density_diffusion: spec.density_diffusion,
+            density_diffusion_uncorrected: false,
         };
         // The walls' boxes before the first accelerations: they carry the walls' repulsion (none unless a block
         // starts within its range).
@@ -326,6 +335,26 @@ impl WcsphSolver {
     /// Sets the APD β (§4.4; 0 disables) for the following steps.
     pub fn set_apd(&mut self, beta: f64) {
         self.options.apd = beta;
+    }
+
+    /// Sets the δ of the density diffusion (0 disables it) and whether it keeps the hydrostatic correction, for the
+    /// following steps (see [`WcsphOptions::density_diffusion`]).
+    pub fn set_density_diffusion(&mut self, delta: f64, hydrostatic_correction: bool) {
+        self.options.density_diffusion = delta;
+        self.options.density_diffusion_uncorrected = !hydrostatic_correction;
+    }
+
+    /// The δ-SPH density diffusion in force, `None` when off.
+    pub fn density_diffusion(&self) -> Option<DensityDiffusion> {
+        let o = &self.options;
+        let p = &self.params;
+        (o.density_diffusion > 0.0).then(|| {
+            if o.density_diffusion_uncorrected {
+                DensityDiffusion::uncorrected(o.density_diffusion, p.h, p.c0)
+            } else {
+                DensityDiffusion::new(o.density_diffusion, p.h, p.c0, p.rho0, p.gravity)
+            }
+        })
     }
 
     /// The kernel.
@@ -647,11 +676,16 @@ impl WcsphSolver {
         self.scratch.per1 = drho;
     }
 
-    /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9)).
+    /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9), with the δ-SPH diffusion when on).
     fn density_half_kick(&mut self, dt: f64) {
         let nf = self.state.len();
         let mut drho = std::mem::take(&mut self.scratch.per1);
-        continuity::density_rates_pairs_into(&self.view(), &self.sorted.vol, &self.scratch.list, &mut drho);
+        if let Some(d) = self.density_diffusion() {
+            let (view, vol, list) = (self.view(), &self.sorted.vol, &self.scratch.list);
+            continuity::density_rates_pairs_diffusive_into(&view, vol, list, &d, &mut drho);
+        } else {
+            continuity::density_rates_pairs_into(&self.view(), &self.sorted.vol, &self.scratch.list, &mut drho);
+        }
         let s = &mut self.sorted;
         integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);

@@ -134,6 +134,7 @@ fn oscillating_drop_period() {
         mls: false,
         apd: 0.04,
         central_force: 0.0,
+        ..Default::default()
     };
     let (period, a_max, _, worst) = run(20, 20.0, options, Some(20), 0.5);
     assert!((period / T_EXACT - 1.0).abs() < 0.03, "period {period}");

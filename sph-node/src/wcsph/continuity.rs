@@ -2,6 +2,7 @@
 
 use rayon::prelude::*;
 
+use super::density_diffusion::DensityDiffusion;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
@@ -52,4 +53,46 @@ pub fn density_rate_pairs(i: usize, view: &ParticleView<'_>, vol: &[f64], neighb
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j.
 pub fn density_rates_pairs_into(view: &ParticleView<'_>, vol: &[f64], list: &NeighborList, out: &mut Vec<f64>) {
     list.map_pairs_into(out, |i, idx, grad| density_rate_pairs(i, view, vol, idx, grad));
+}
+
+/// [`density_rate_pairs`] plus the δ-SPH diffusive term D_i of fluid–fluid pairs ([`DensityDiffusion`]), in the
+/// same pass over the neighbours (the continuity part is summed exactly as in [`density_rate_pairs`]).
+#[inline]
+pub fn density_rate_pairs_diffusive(
+    i: usize,
+    view: &ParticleView<'_>,
+    vol: &[f64],
+    neighbors: &[u32],
+    grad: &[f64],
+    diffusion: &DensityDiffusion,
+) -> f64 {
+    let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
+    let mut sum = 0.0;
+    let mut diff = 0.0;
+    for (&j, &f) in neighbors.iter().zip(grad) {
+        let j = j as usize;
+        let (xj, vj) = (view.x[j], view.v[j]);
+        let grad = [f * (xi[0] - xj[0]), f * (xi[1] - xj[1])];
+        let v_ij = [vi[0] - vj[0], vi[1] - vj[1]];
+        // Eq. (9), Long et al. 2016
+        sum += vol[j] * dot(v_ij, grad);
+        if j < view.n_fluid {
+            // Molteni & Colagrossi 2009 with Fourtakas et al. 2019 (density_diffusion.rs)
+            diff += diffusion.pair(xi, xj, rho_i, view.rho[j], f, vol[j]);
+        }
+    }
+    rho_i * sum - diffusion.coef * diff // Eq. (9), Long et al. 2016, + D_i
+}
+
+/// [`density_rates_pairs_into`] with the δ-SPH term ([`density_rate_pairs_diffusive`]).
+pub fn density_rates_pairs_diffusive_into(
+    view: &ParticleView<'_>,
+    vol: &[f64],
+    list: &NeighborList,
+    diffusion: &DensityDiffusion,
+    out: &mut Vec<f64>,
+) {
+    list.map_pairs_into(out, |i, idx, grad| {
+        density_rate_pairs_diffusive(i, view, vol, idx, grad, diffusion)
+    });
 }
