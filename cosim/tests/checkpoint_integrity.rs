@@ -15,6 +15,10 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use common::*;
+use contact_broker::checkpoint::BrokerState;
+use cosim_proto::messages::Correction;
+use sph_node::core::Fluid;
+use sph_node::stability::EnergyGuard;
 
 /// Bound on every run; no test may hang.
 const LIMIT: Duration = Duration::from_secs(120);
@@ -164,4 +168,79 @@ fn an_old_format_or_incomplete_manifest_is_refused() {
         &dir.join("out-partial"),
         &["checkpoint.json", "does not list sph.bin"],
     );
+}
+
+/// `file` of the checkpoint `ck` replaced by `bytes`, its size and checksum recorded in the manifest as a tool
+/// that writes checkpoints would record them.
+fn rewrite(ck: &Path, file: &str, bytes: &[u8]) {
+    std::fs::write(ck.join(file), bytes).unwrap();
+    let path = ck.join("checkpoint.json");
+    let mut manifest = json(&path);
+    manifest["files"][file] = serde_json::json!({
+        "bytes": bytes.len(),
+        "crc32": format!("{:08x}", crc32fast::hash(bytes)),
+    });
+    std::fs::write(&path, manifest.to_string()).unwrap();
+}
+
+#[test]
+fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_the_field() {
+    let dir = scratch("ck-integrity-state");
+    let ck = first_checkpoint(&dir);
+
+    // broker.bin naming a fluid particle the run does not have: refused before anything starts.
+    let bad = copy_of(&ck, &dir.join("broker-id"));
+    type SavedBroker = (String, u32, BrokerState);
+    let (tag, format, mut state): SavedBroker =
+        bincode::deserialize(&std::fs::read(ck.join("broker.bin")).unwrap()).unwrap();
+    let particles = state.summary.particles;
+    let k = state.pending_sph.len();
+    state.pending_sph.push(Correction {
+        id: particles as u32 + 5,
+        dx: [0.0; 2],
+        dv: [0.0; 2],
+    });
+    rewrite(&bad, "broker.bin", &bincode::serialize(&(tag, format, state)).unwrap());
+    assert_refused(
+        &bad,
+        &dir.join("out-broker-id"),
+        &[
+            "broker.bin",
+            &format!(
+                "pending_sph[0].id = {}, but there are {particles} fluid particles",
+                particles + 5
+            ),
+        ],
+    );
+
+    // sph.bin with one velocity more than there are particles: the fluid node refuses it when it starts, reports it
+    // on its error topic, and the run fails with that reason (exit 1, summary.json `failed`).
+    let bad = copy_of(&ck, &dir.join("sph-length"));
+    type SavedFluid = (String, u32, Fluid, EnergyGuard);
+    let (tag, version, mut fluid, guard): SavedFluid =
+        bincode::deserialize(&std::fs::read(ck.join("sph.bin")).unwrap()).unwrap();
+    let n = fluid.state().len();
+    fluid.state_mut().v.push([0.0; 2]);
+    rewrite(
+        &bad,
+        "sph.bin",
+        &bincode::serialize(&(tag, version, &fluid, &guard)).unwrap(),
+    );
+    let why = format!(
+        "checkpoint: state.v holds {} entries, there are {n} fluid particles",
+        n + 1
+    );
+    let out = dir.join("out-sph-length");
+    let got = restart(&bad, &out, false);
+    let stderr = String::from_utf8_lossy(&got.stderr);
+    assert_eq!(got.status.code(), Some(1), "the run fails: {stderr}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    let message = summary["message"].as_str().unwrap();
+    assert!(message.contains("sph-node") && message.contains(&why), "{message}");
+    // In one process the same refusal, from the same check.
+    let got = restart(&bad, &dir.join("out-sph-length-in-process"), true);
+    let stderr = String::from_utf8_lossy(&got.stderr);
+    assert_eq!(got.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("sph-node") && stderr.contains(&why), "{stderr}");
 }
