@@ -207,7 +207,7 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
         &[
             "broker.bin",
             &format!(
-                "pending_sph[0].id = {}, but there are {particles} fluid particles",
+                "pending_sph[{k}].id = {}, but there are {particles} fluid particles",
                 particles + 5
             ),
         ],

@@ -87,7 +87,9 @@ fn its_own_checkpoint_continues_bit_for_bit() {
 #[test]
 fn lengths_that_disagree_are_refused_naming_the_field() {
     assert_eq!(
-        refused(&edited(|s| drop(s.v.pop()))),
+        refused(&edited(|s| {
+            s.v.pop();
+        })),
         "checkpoint: state.v holds 5 nodes, the model has 6"
     );
     assert_eq!(

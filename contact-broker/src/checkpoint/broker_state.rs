@@ -300,7 +300,9 @@ component = "x"
     fn lengths_that_disagree_are_refused_naming_the_field() {
         let e = refused(|s| s.rows[1].1.push(0.0));
         assert_eq!(e, "rows[1] holds 2 values, the scene has 1 probes");
-        let e = refused(|s| drop(s.load.as_mut().unwrap().pop()));
+        let e = refused(|s| {
+            s.load.as_mut().unwrap().pop();
+        });
         assert_eq!(e, "load holds 5 nodes, the structure has 6");
         let e = refused(|s| s.fluid_origin = Some(vec![[0.0; 2]; 17]));
         assert_eq!(e, "fluid_origin holds 17 positions, the fluid has 16 particles");

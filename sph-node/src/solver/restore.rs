@@ -203,12 +203,16 @@ mod tests {
             e,
             format!("state.v holds {} entries, there are {n} fluid particles", n + 1)
         );
-        let e = refused(|s| drop(s.accel.pop()));
+        let e = refused(|s| {
+            s.accel.pop();
+        });
         assert_eq!(
             e,
             format!("accel holds {} entries, there are {n} fluid particles", n - 1)
         );
-        let e = refused(|s| drop(s.sorted.pr2.pop()));
+        let e = refused(|s| {
+            s.sorted.pr2.pop();
+        });
         assert!(e.starts_with("sorted.pr2 holds"), "{e}");
         let e = refused(|s| s.walls.p.push(0.0));
         assert!(e.starts_with("walls.p holds"), "{e}");

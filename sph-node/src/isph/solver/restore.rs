@@ -139,7 +139,9 @@ mod tests {
     fn lengths_that_disagree_are_refused_naming_the_field() {
         let (solver, _) = stepped();
         let (nf, nw) = (solver.state.len(), solver.walls.len());
-        let e = refused(|s| drop(s.state.p.pop()));
+        let e = refused(|s| {
+            s.state.p.pop();
+        });
         assert_eq!(
             e,
             format!("state.p holds {} entries, there are {nf} fluid particles", nf - 1)
