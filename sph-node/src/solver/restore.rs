@@ -59,6 +59,9 @@ impl WcsphSolver {
         if self.state_edited {
             // The state was handed out for edits that the next step takes over: only the walls must agree.
             finite2("sorted.x", &s.x)?;
+            if let Some(k) = s.x[..nf].iter().position(|x| !domain.contains(*x)) {
+                return Err(format!("sorted.x[{k}] = {:?} is outside the fluid's domain", s.x[k]));
+            }
             finite2("sorted.v", &s.v)?;
             finite("sorted.p", &s.p)?;
             same_bits("sorted.x (walls)", &s.x[nf..], &self.walls.x, "walls.x")?;
@@ -193,6 +196,20 @@ mod tests {
             assert_eq!(solver.check_restored(&fresh), Ok(()), "{sets:?}");
             assert_eq!(fresh.check_restored(&fresh), Ok(()), "{sets:?}");
         }
+    }
+
+    #[test]
+    fn edits_not_yet_taken_pass_but_the_working_copy_stays_in_the_domain() {
+        let (mut solver, fresh) = stepped();
+        solver.state_mut().x[0][0] += 1e-5;
+        assert_eq!(solver.check_restored(&fresh), Ok(()));
+        // Far out but finite: the cell grid of the check (and of the next step) would not fit in memory.
+        let k = solver.sorted.slot[1] as usize;
+        solver.sorted.x[k] = [1e200, 0.0];
+        assert_eq!(
+            solver.check_restored(&fresh),
+            Err(format!("sorted.x[{k}] = [1e200, 0.0] is outside the fluid's domain"))
+        );
     }
 
     #[test]
