@@ -32,7 +32,7 @@ fn step(dt: f64) -> StepCommand {
 fn saved(solver: &str) -> Vec<u8> {
     let mut core = SphCore::new(&scene(solver)).unwrap();
     for _ in 0..3 {
-        core.handle(&step(2e-3)).unwrap();
+        core.handle(&step(1e-3)).unwrap();
     }
     core.checkpoint()
 }
@@ -65,7 +65,7 @@ fn its_own_checkpoint_is_taken_and_continues_bit_for_bit() {
         let mut b = SphCore::new(&scene(solver)).unwrap();
         b.restore(&data).unwrap();
         let answer = |core: &mut SphCore| {
-            let mut s = core.handle(&step(2e-3)).unwrap().unwrap();
+            let mut s = core.handle(&step(1e-3)).unwrap().unwrap();
             s.compute_seconds = 0.0; // wall-clock time, the one field that is not computed
             s
         };
