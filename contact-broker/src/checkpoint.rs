@@ -4,7 +4,8 @@
 //! A checkpoint is taken between two coupling steps, when every node has answered step `step` and the contact
 //! corrections of that step are computed but not yet sent. It is a folder `DIR/checkpoints/<step>/`:
 //!
-//! - `checkpoint.json`: the manifest ([`Manifest`]): format and protocol version, run id, step, t, file sizes;
+//! - `checkpoint.json`: the manifest ([`Manifest`]): format and protocol version, run id, step, t, and the size and
+//!   CRC-32 of every other file;
 //! - `scene.toml`: the resolved scene the run was started with;
 //! - `broker.bin`: the coordinator's state ([`BrokerState`]): time, step, the pending corrections, the probe rows
 //!   so far, the summary's counters;
@@ -13,8 +14,12 @@
 //! The folder is written under a temporary name (`.<step>.<pid>.partial`, so that two runs writing into one
 //! folder by mistake do not write into each other's), each file and the folder are flushed to the disk
 //! (`fsync`), and only then is it renamed: a run, or a machine, that dies while it writes never leaves a half
-//! checkpoint that looks whole. [`open`] checks every file's size against the manifest, so a checkpoint damaged
-//! afterwards (a copy cut short, a full disk) is refused naming the file. Pure: files only, no messaging.
+//! checkpoint that looks whole. [`open`] reads every file once and checks its size and checksum against the
+//! manifest before it looks inside any, so a checkpoint damaged afterwards (a copy cut short, a full disk, a changed
+//! byte) is refused naming the file; what it then decodes from `broker.bin` is checked as well
+//! ([`BrokerState::check`]). Pure: files only, no messaging.
+
+mod broker_state;
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -23,17 +28,18 @@ use std::time::Instant;
 
 use anyhow::Context;
 use cosim_proto::envelope::PROTOCOL_VERSION;
-use cosim_proto::messages::Correction;
 use cosim_proto::scene::LoadedScene;
 use serde::{Deserialize, Serialize};
 
-use crate::summary::Summary;
+pub use broker_state::BrokerState;
 
-/// Version of the checkpoint folder's layout and of `broker.bin`.
-pub const FORMAT: u32 = 1;
+/// Version of the checkpoint folder's layout and of `broker.bin`. 2: the manifest holds each file's CRC-32.
+pub const FORMAT: u32 = 2;
 /// The manifest's file name.
 pub const MANIFEST: &str = "checkpoint.json";
 const TAG: &str = "cosim-broker-checkpoint";
+/// The files a checkpoint folder may hold besides the manifest.
+const FILES: [&str; 4] = ["scene.toml", "broker.bin", "fem.bin", "sph.bin"];
 
 /// `checkpoint.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -50,41 +56,34 @@ pub struct Manifest {
     pub step: u64,
     /// Simulated time reached [s].
     pub t: f64,
-    /// Size of each file [bytes].
-    pub files: BTreeMap<String, u64>,
+    /// Every other file of the folder, by name.
+    pub files: BTreeMap<String, FileEntry>,
     /// Seconds it took to gather the nodes' states and write the folder.
     pub write_seconds: f64,
 }
 
-/// The coordinator's state between two steps: what, with the nodes' states, makes the continued run the same.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct BrokerState {
-    /// Coupling steps completed.
-    pub step: u64,
-    /// Simulated time [s].
-    pub t: f64,
-    /// Index of the next output time.
-    pub next_output: u64,
-    /// Index of the next checkpoint time.
-    pub next_checkpoint: u64,
-    /// The fluid's stable step last reported [s].
-    pub dt_fluid: f64,
-    /// Contact corrections of the last step, still to be sent to the structure node.
-    pub pending_fem: Vec<Correction>,
-    /// … and to the fluid node.
-    pub pending_sph: Vec<Correction>,
-    /// Region of interest of the next fluid command.
-    pub roi: Option<[f64; 4]>,
-    /// Interface load of the last output step.
-    pub load: Option<Vec<[f64; 2]>>,
-    /// Fluid particles exchanged over the run.
-    pub exchanged: u64,
-    /// Fluid positions of the first sample (potential energy probes).
-    pub fluid_origin: Option<Vec<[f64; 2]>>,
-    /// Every probe row so far: time and values.
-    pub rows: Vec<(f64, Vec<f64>)>,
-    /// The summary's counters so far.
-    pub summary: Summary,
+/// One file of a checkpoint as the manifest records it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FileEntry {
+    /// Size [bytes].
+    pub bytes: u64,
+    /// CRC-32 (IEEE, as zlib and `crc32fast` compute it) of the whole file: 8 lowercase hex digits.
+    pub crc32: String,
+}
+
+impl FileEntry {
+    /// The entry of `bytes`.
+    pub fn of(bytes: &[u8]) -> Self {
+        Self {
+            bytes: bytes.len() as u64,
+            crc32: crc32_hex(bytes),
+        }
+    }
+}
+
+/// CRC-32 of `bytes` as 8 lowercase hex digits.
+fn crc32_hex(bytes: &[u8]) -> String {
+    format!("{:08x}", crc32fast::hash(bytes))
 }
 
 /// A checkpoint read back and checked against the scene of the run that continues from it.
@@ -145,7 +144,7 @@ pub fn write(
     let mut put = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
         let path = tmp.join(name);
         write_synced(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
-        files.insert(name.to_string(), bytes.len() as u64);
+        files.insert(name.to_string(), FileEntry::of(bytes));
         Ok(())
     };
     put("scene.toml", scene.scene.to_toml().as_bytes())?;
@@ -175,7 +174,7 @@ pub fn write(
     std::fs::rename(&tmp, &dir).with_context(|| format!("cannot rename {} to {}", tmp.display(), dir.display()))?;
     sync_dir(&root)?;
     Ok(Written {
-        bytes: manifest.files.values().sum::<u64>() + text.len() as u64,
+        bytes: manifest.files.values().map(|f| f.bytes).sum::<u64>() + text.len() as u64,
         dir,
         seconds: started.elapsed().as_secs_f64(),
     })
@@ -195,8 +194,10 @@ fn sync_dir(dir: &Path) -> anyhow::Result<()> {
         .with_context(|| format!("cannot flush {} to the disk", dir.display()))
 }
 
-/// Read the checkpoint `dir` and check that `scene` may continue from it: same format and protocol version, and
-/// the same scene but for `run.end_time` (a restart may run longer or shorter). Every refusal names the file.
+/// Read the checkpoint `dir` and check that `scene` may continue from it: same format and protocol version, every
+/// file whole (size and CRC-32 of the manifest), the same scene but for `run.end_time` (a restart may run longer or
+/// shorter), and a coordinator state that holds together ([`BrokerState::check`]). Every refusal is one line naming
+/// the file.
 pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
     let manifest_path = dir.join(MANIFEST);
     let text = std::fs::read_to_string(&manifest_path).with_context(|| {
@@ -205,20 +206,27 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
             manifest_path.display()
         )
     })?;
-    let manifest: Manifest = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a checkpoint manifest", manifest_path.display()))?;
+    let not_manifest =
+        |e: serde_json::Error| anyhow::anyhow!("{}: not a checkpoint manifest: {e}", manifest_path.display());
+    // The versions first, from the bare JSON: a manifest of another format need not have this one's fields.
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(not_manifest)?;
+    let version = |key: &str| value.get(key).and_then(serde_json::Value::as_u64);
+    let protocol_version = version("protocol_version");
     anyhow::ensure!(
-        manifest.protocol_version == PROTOCOL_VERSION,
+        protocol_version == Some(u64::from(PROTOCOL_VERSION)),
         "{}: written by protocol version {}, this build speaks {PROTOCOL_VERSION}; restart with the build that wrote it",
         manifest_path.display(),
-        manifest.protocol_version
+        protocol_version.map_or("(none)".into(), |v| v.to_string())
     );
+    let format = version("format");
     anyhow::ensure!(
-        manifest.format == FORMAT,
-        "{}: checkpoint format {}, this build reads format {FORMAT}",
+        format == Some(u64::from(FORMAT)),
+        "{}: checkpoint format {}, this build reads format {FORMAT} (format 1 has no checksums); restart with the \
+         build that wrote it",
         manifest_path.display(),
-        manifest.format
+        format.map_or("(none)".into(), |v| v.to_string())
     );
+    let manifest: Manifest = serde_json::from_value(value).map_err(not_manifest)?;
     anyhow::ensure!(
         scene.scene.run.end_time > manifest.t,
         "{}: the checkpoint is at t = {} s and run.end_time = {} s: nothing to run (set a later run.end_time)",
@@ -226,22 +234,13 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
         manifest.t,
         scene.scene.run.end_time
     );
-    for (name, size) in &manifest.files {
-        let path = dir.join(name);
-        let len = std::fs::metadata(&path)
-            .with_context(|| format!("{}: missing, {} lists it", path.display(), manifest_path.display()))?
-            .len();
-        anyhow::ensure!(
-            len == *size,
-            "{}: {len} bytes where {} says {size}: the checkpoint is damaged (cut short or changed)",
-            path.display(),
-            manifest_path.display()
-        );
-    }
+    let files = read_files(dir, &manifest, &manifest_path, scene)?;
+    let file = |name: &str| files.get(name).map(Vec::as_slice).unwrap_or_default();
+
     let scene_path = dir.join("scene.toml");
     let saved_text =
-        std::fs::read_to_string(&scene_path).with_context(|| format!("cannot read {}", scene_path.display()))?;
-    let mut saved = cosim_proto::scene::parse(&scene_path.display().to_string(), &saved_text, &[])?;
+        std::str::from_utf8(file("scene.toml")).with_context(|| format!("{}: not UTF-8 text", scene_path.display()))?;
+    let mut saved = cosim_proto::scene::parse(&scene_path.display().to_string(), saved_text, &[])?;
     saved.run.end_time = scene.scene.run.end_time;
     if let Some((ours, theirs)) = first_difference(&scene.scene.to_toml(), &saved.to_toml()) {
         anyhow::bail!(
@@ -251,12 +250,8 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
             scene.path.display()
         );
     }
-    let read = |name: &str| -> anyhow::Result<Vec<u8>> {
-        let path = dir.join(name);
-        std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))
-    };
     let broker_path = dir.join("broker.bin");
-    let (tag, format, broker): (String, u32, BrokerState) = bincode::deserialize(&read("broker.bin")?)
+    let (tag, format, broker): (String, u32, BrokerState) = bincode::deserialize(file("broker.bin"))
         .with_context(|| format!("{}: not a broker state", broker_path.display()))?;
     anyhow::ensure!(
         tag == TAG && format == FORMAT,
@@ -273,21 +268,77 @@ pub fn open(dir: &Path, scene: &LoadedScene) -> anyhow::Result<Restart> {
         manifest.step,
         manifest.t
     );
-    let fem = match scene.scene.solids.is_empty() {
-        false => Some(read("fem.bin")?),
-        true => None,
-    };
-    let sph = match scene.scene.fluid {
-        Some(_) => Some(read("sph.bin")?),
-        None => None,
-    };
+    broker
+        .check(&scene.scene)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", broker_path.display()))?;
+    let mut files = files;
+    let (fem, sph) = (files.remove("fem.bin"), files.remove("sph.bin"));
     Ok(Restart {
         dir: dir.to_path_buf(),
+        fem: fem.filter(|_| !scene.scene.solids.is_empty()),
+        sph: sph.filter(|_| scene.scene.fluid.is_some()),
         manifest,
         broker,
-        fem,
-        sph,
     })
+}
+
+/// Read every file the manifest lists, once, and check its size and CRC-32 before anything looks inside: the
+/// manifest must list exactly the files a checkpoint of `scene` holds (`scene.toml`, `broker.bin`, and `fem.bin` /
+/// `sph.bin` when the scene has a structure / a fluid), so that nothing is read unchecked.
+fn read_files(
+    dir: &Path,
+    manifest: &Manifest,
+    manifest_path: &Path,
+    scene: &LoadedScene,
+) -> anyhow::Result<BTreeMap<String, Vec<u8>>> {
+    let s = &scene.scene;
+    let needed = FILES.iter().filter(|&&name| match name {
+        "fem.bin" => !s.solids.is_empty(),
+        "sph.bin" => s.fluid.is_some(),
+        _ => true,
+    });
+    for name in needed {
+        anyhow::ensure!(
+            manifest.files.contains_key(*name),
+            "{}: does not list {name}, which a checkpoint of this scene holds",
+            manifest_path.display()
+        );
+    }
+    let mut files = BTreeMap::new();
+    for (name, entry) in &manifest.files {
+        anyhow::ensure!(
+            FILES.contains(&name.as_str()),
+            "{}: lists `{name}`, which is not a checkpoint file (expected {})",
+            manifest_path.display(),
+            FILES.join(", ")
+        );
+        let path = dir.join(name);
+        let bytes = std::fs::read(&path).with_context(|| {
+            format!(
+                "{}: missing or unreadable, {} lists it",
+                path.display(),
+                manifest_path.display()
+            )
+        })?;
+        anyhow::ensure!(
+            bytes.len() as u64 == entry.bytes,
+            "{}: {} bytes where {} says {}: the checkpoint is damaged (cut short or changed)",
+            path.display(),
+            bytes.len(),
+            manifest_path.display(),
+            entry.bytes
+        );
+        let found = crc32_hex(&bytes);
+        anyhow::ensure!(
+            found == entry.crc32,
+            "{}: checksum crc32 {found} where {} expects {}: the checkpoint is damaged (changed after it was written)",
+            path.display(),
+            manifest_path.display(),
+            entry.crc32
+        );
+        files.insert(name.clone(), bytes);
+    }
+    Ok(files)
 }
 
 /// The first line that differs between two texts, `(ours, theirs)`; `None` when they are equal.

@@ -243,6 +243,7 @@ fn drive(
     match &plan.restart {
         // Continue where the checkpoint left off: the nodes restored their own states when they started.
         Some(saved) => {
+            saved.check_nodes(summary.fem_nodes, summary.particles)?;
             (t, step, next_output, dt_fluid) = (saved.t, saved.step, saved.next_output, saved.dt_fluid);
             // From the time, not the saved index: the restart may ask for another interval.
             next_checkpoint = plan

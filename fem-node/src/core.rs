@@ -3,6 +3,8 @@
 
 use std::time::Instant;
 
+use bincode::Options;
+
 use cosim_proto::messages::{FemMesh, FemState, StepCommand};
 use cosim_proto::scene::Scene;
 
@@ -57,14 +59,20 @@ impl FemCore {
         bincode::serialize(&saved).expect("in-memory bincode encoding of plain data")
     }
 
-    /// Continue from [`FemCore::checkpoint`]'s bytes, on a core built from the same scene.
+    /// Continue from [`FemCore::checkpoint`]'s bytes, on a core built from the same scene. The state is checked
+    /// before it is used ([`SolverState::check`]): one entry per node of the model, finite, clamped nodes at rest
+    /// where they are clamped; a state that does not hold together is refused naming the field, and the core keeps
+    /// the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), FemError> {
         let invalid = |message: String| FemError::InvalidParameter {
             name: "checkpoint",
             message,
         };
-        let (tag, version, state, stale): (String, u32, SolverState, bool) =
-            bincode::deserialize(data).map_err(|e| invalid(format!("not a structure node's state: {e}")))?;
+        let (tag, version, state, stale): (String, u32, SolverState, bool) = bincode::DefaultOptions::new()
+            .with_fixint_encoding()
+            .reject_trailing_bytes()
+            .deserialize(data)
+            .map_err(|e| invalid(format!("not a structure node's state: {e}")))?;
         if (tag.as_str(), version) != CHECKPOINT_TAG {
             return Err(invalid(format!(
                 "holds `{tag}` version {version}, this fem-node reads `{}` version {}",

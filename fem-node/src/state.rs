@@ -34,6 +34,41 @@ impl FemState {
         }
     }
 
+    /// Check a state read back from outside (a checkpoint) before a solver of `model` continues from it: one
+    /// position, velocity and acceleration per node of the model, every value finite, the time finite and not
+    /// negative, and every clamped node where the solver keeps it (`x = X`, `v = a = 0`). `Err` is one line naming
+    /// the field, the node and the value.
+    pub fn check(&self, model: &FemModel) -> Result<(), String> {
+        let n = model.node_count();
+        if !(self.t.is_finite() && self.t >= 0.0) {
+            return Err(format!("state.t = {} is not a time", self.t));
+        }
+        for (field, values) in [("x", &self.x), ("v", &self.v), ("a", &self.a)] {
+            if values.len() != n {
+                return Err(format!("state.{field} holds {} nodes, the model has {n}", values.len()));
+            }
+            if let Some(k) = values.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+                return Err(format!("state.{field}[{k}] = {:?} is not finite", values[k]));
+            }
+        }
+        let clamped = model
+            .fixed()
+            .iter()
+            .zip(model.reference())
+            .enumerate()
+            .filter(|(_, (f, _))| **f);
+        for (k, (_, reference)) in clamped {
+            // Indexing is in bounds: every field holds `n` nodes, checked above.
+            let (x, v, a) = (self.x[k], self.v[k], self.a[k]);
+            if x != *reference || v != [0.0; 2] || a != [0.0; 2] {
+                return Err(format!(
+                    "state: node {k} is clamped at {reference:?} but has x {x:?}, v {v:?}, a {a:?}"
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Displacement `x − X` of node `k`.
     pub fn displacement(&self, model: &FemModel, k: usize) -> [f64; 2] {
         let r = model.reference()[k];

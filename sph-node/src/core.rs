@@ -7,6 +7,7 @@ use std::time::Instant;
 use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::Scene;
 
+use bincode::Options;
 use cosim_proto::scene::{FluidSolver, PpeSourceKind};
 use serde::{Deserialize, Serialize};
 
@@ -158,14 +159,20 @@ impl SphCore {
             .expect("in-memory bincode encoding of plain data")
     }
 
-    /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene.
+    /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene. What the bytes hold is
+    /// checked before it is used ([`crate::restore`]): against the solver this core built from the scene, and for
+    /// consistency with itself; a state that does not hold together is refused naming the field, and the core
+    /// keeps the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), SphError> {
         let invalid = |message: String| SphError::InvalidParameter {
             name: "checkpoint",
             message,
         };
-        let (tag, version, solver, guard): (String, u32, Fluid, EnergyGuard) =
-            bincode::deserialize(data).map_err(|e| invalid(format!("not a fluid node's state: {e}")))?;
+        let (tag, version, solver, guard): (String, u32, Fluid, EnergyGuard) = bincode::DefaultOptions::new()
+            .with_fixint_encoding()
+            .reject_trailing_bytes()
+            .deserialize(data)
+            .map_err(|e| invalid(format!("not a fluid node's state: {e}")))?;
         if (tag.as_str(), version) != CHECKPOINT_TAG {
             return Err(invalid(format!(
                 "holds `{tag}` version {version}, this sph-node reads `{}` version {}",
@@ -178,8 +185,17 @@ impl SphCore {
                 "holds {saved} fluid particles, the scene makes {scene} (another scene?)"
             )));
         }
-        if std::mem::discriminant(&solver) != std::mem::discriminant(&self.solver) {
-            return Err(invalid("saved with the other fluid.solver".into()));
+        match (&solver, &self.solver) {
+            (Fluid::Wcsph(saved), Fluid::Wcsph(scene)) => saved.check_restored(scene),
+            (Fluid::Isph(saved), Fluid::Isph(scene)) => saved.check_restored(scene),
+            _ => Err("saved with the other fluid.solver".into()),
+        }
+        .map_err(invalid)?;
+        if guard != self.guard {
+            return Err(invalid(format!(
+                "guard.bound = {} where the scene gives {}",
+                guard.bound, self.guard.bound
+            )));
         }
         self.solver = solver;
         self.guard = guard;

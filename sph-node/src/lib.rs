@@ -28,6 +28,7 @@ pub mod kernel;
 pub mod neighbors;
 pub mod node;
 pub mod particles;
+mod restore;
 pub mod setup;
 pub mod solver;
 pub mod stability;

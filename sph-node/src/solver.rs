@@ -38,6 +38,8 @@ use crate::setup;
 use crate::time_step;
 use crate::wcsph::{continuity, momentum, DensityDiffusion, MomentumParams};
 
+mod restore;
+
 /// Resolved parameters of the fluid.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SphParams {

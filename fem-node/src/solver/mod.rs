@@ -92,15 +92,13 @@ impl FemSolver {
     }
 
     /// Continue from a saved state (a checkpoint): the state as it was, accelerations included, and whether they
-    /// were to be recomputed. The model must be the one the state was saved from (same node count).
+    /// were to be recomputed. The state is checked against the model first ([`FemState::check`]); one that does not
+    /// hold together is refused and the solver keeps its own.
     pub fn resume(&mut self, state: FemState, accelerations_stale: bool) -> Result<()> {
-        let n = self.model.node_count();
-        if state.x.len() != n || state.v.len() != n || state.a.len() != n {
-            return Err(FemError::InvalidParameter {
-                name: "state",
-                message: format!("the saved state holds {} nodes, the model {n}", state.x.len()),
-            });
-        }
+        state.check(&self.model).map_err(|message| FemError::InvalidParameter {
+            name: "checkpoint",
+            message,
+        })?;
         self.state = state;
         self.accelerations_stale = accelerations_stale;
         Ok(())

@@ -215,6 +215,45 @@ impl ContactLayer {
         self.corrected = corrected;
     }
 
+    /// Check a layer read back from a checkpoint (see [`crate::restore`]) against the state it was saved with,
+    /// between two steps: the end of the last step is that state, and the per-particle records are either not made
+    /// yet or one per particle, with finite faces, points and times.
+    pub(crate) fn check(&self, state: &FluidState) -> crate::restore::Check {
+        use crate::restore::{finite, finite2, same_bits};
+        same_bits("contact.x_end", &self.x_end, &state.x, "state.x")?;
+        same_bits("contact.v_end", &self.v_end, &state.v, "state.v")?;
+        let n = state.len();
+        let records = [
+            ("face", self.face.len()),
+            ("point", self.point.len()),
+            ("time", self.time.len()),
+            ("measured", self.measured.len()),
+            ("age", self.age.len()),
+            ("flags", self.flags.len()),
+        ];
+        let m = self.age.len();
+        if let Some((field, len)) = records.iter().find(|(_, len)| *len != m || !(m == 0 || m == n)) {
+            return Err(format!(
+                "contact.{field} holds {len} records (contact.age {m}), there are {n} fluid particles"
+            ));
+        }
+        let faces: Vec<[f64; 2]> = self.face.iter().map(|f| f.normal).collect();
+        finite2("contact.face.normal", &faces)?;
+        let offsets: Vec<f64> = self.face.iter().map(|f| f.offset).collect();
+        finite("contact.face.offset", &offsets)?;
+        let velocities: Vec<f64> = self.face.iter().map(|f| f.velocity).collect();
+        finite("contact.face.velocity", &velocities)?;
+        finite2("contact.point", &self.point)?;
+        finite("contact.time", &self.time)?;
+        if self.corrected > n {
+            return Err(format!(
+                "contact.corrected = {}, there are {n} fluid particles",
+                self.corrected
+            ));
+        }
+        Ok(())
+    }
+
     /// The face particle `i` was against at the start of the step.
     #[inline]
     pub fn face(&self, i: usize) -> Option<Face> {
@@ -311,6 +350,40 @@ pub fn face_normal_velocity(u: [f64; 2], face: &Face, dt: f64, gravity: [f64; 2]
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A layer read back from a checkpoint: its records are one per particle or none, its end the state's.
+    #[test]
+    fn a_restored_layer_is_checked_against_its_state() {
+        let state = FluidState {
+            x: vec![[0.0, 0.0], [0.01, 0.0]],
+            v: vec![[0.0; 2]; 2],
+            rho: vec![1000.0; 2],
+            p: vec![0.0; 2],
+            m: vec![0.1; 2],
+            ..FluidState::default()
+        };
+        let mut layer = ContactLayer::default();
+        layer.record_end(&state);
+        assert_eq!(layer.check(&state), Ok(()));
+        let mut moved = state.clone();
+        moved.v[1] = [0.0, -0.1];
+        layer.detect(&moved, 0.01);
+        layer.record_end(&moved);
+        assert_eq!(layer.check(&moved), Ok(()), "records made by a correction");
+        let mut short = layer.clone();
+        short.face.pop();
+        assert_eq!(
+            short.check(&moved),
+            Err("contact.face holds 1 records (contact.age 2), there are 2 fluid particles".into())
+        );
+        let mut bad = layer.clone();
+        bad.time[0] = f64::NAN;
+        assert_eq!(bad.check(&moved), Err("contact.time[0] = NaN is not finite".into()));
+        assert_eq!(
+            layer.check(&state),
+            Err("contact.v_end[1] = [0.0, -0.1] where state.v has [0.0, 0.0]".into())
+        );
+    }
 
     #[test]
     fn half_space_of_the_default_kernel() {

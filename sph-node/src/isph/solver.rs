@@ -30,6 +30,8 @@ use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup;
 use crate::solver::SphParams;
 
+mod restore;
+
 /// Scratch rebuilt every step: nothing here is state.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 struct Scratch {

@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 use crate::boundary::walls::filled_box;
 
 /// The wall boxes of a scene.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct WallBoxes {
     boxes: Vec<([f64; 2], [f64; 2])>,
     /// A particle put back goes this far out of the face (a millionth of Δx), so that it is outside every box.

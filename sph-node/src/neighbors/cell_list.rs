@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Particles binned on a uniform grid.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CellList {
     origin: [f64; 2],
     cell_size: f64,
@@ -270,6 +270,17 @@ impl ListChunk {
         &mut self.grad[start..end]
     }
 
+    /// The neighbours of the chunk's `k`-th particle and the bits of their ∇W factors (none when the builder did not
+    /// evaluate the kernel), read with `get`: the bounds of lists read back from a checkpoint may point anywhere.
+    fn saved_pairs(&self, k: usize) -> Option<(&[u32], Vec<u64>)> {
+        let r = *self.start.get(k)? as usize..*self.start.get(k + 1)? as usize;
+        let grad = match self.kernel_written {
+            true => self.grad.get(r.clone())?.iter().map(|g| g.to_bits()).collect(),
+            false => Vec::new(),
+        };
+        Some((self.idx.get(r)?, grad))
+    }
+
     fn close_particle(&mut self) {
         self.start.push(self.idx.len() as u32);
     }
@@ -352,6 +363,49 @@ impl NeighborList {
     /// Total number of (ordered) pairs.
     pub fn pair_count(&self) -> usize {
         self.chunks.iter().map(|c| c.idx.len()).sum()
+    }
+
+    /// Where these lists (read back from a checkpoint) differ from `built`, the lists built again from the same
+    /// positions, in one line; `None` when they are the same: the same particles in the same chunks, the same
+    /// neighbours in the same order, the same ∇W factors bit for bit. Checked before anything is indexed, so lists
+    /// that do not hold together are refused rather than read out of bounds. Capacities and the builders' scratch
+    /// contents are left out (never read before they are written), but not the lengths that a later build indexes.
+    pub fn differs_from(&self, built: &NeighborList) -> Option<String> {
+        if self.n != built.n || self.chunks.len() != built.chunks.len() {
+            return Some(format!(
+                "lists of {} particles in {} chunks where the positions give {} in {}",
+                self.n,
+                self.chunks.len(),
+                built.n,
+                built.chunks.len()
+            ));
+        }
+        for (c, (a, b)) in self.chunks.iter().zip(&built.chunks).enumerate() {
+            if (a.first, a.particles, a.kernel_written) != (b.first, b.particles, b.kernel_written) {
+                return Some(format!(
+                    "chunk {c} holds {} particles from {} where the positions give {} from {}",
+                    a.particles, a.first, b.particles, b.first
+                ));
+            }
+            if a.kernel_written && (a.grad.len() < a.idx.len() || a.cand_d2.len() < a.cand_idx.len()) {
+                return Some(format!(
+                    "chunk {c}: {} ∇W factors for {} pairs, {} candidate distances for {} candidates",
+                    a.grad.len(),
+                    a.idx.len(),
+                    a.cand_d2.len(),
+                    a.cand_idx.len()
+                ));
+            }
+            let same = |k: usize| a.saved_pairs(k).is_some() && a.saved_pairs(k) == b.saved_pairs(k);
+            if a.start.len() != b.start.len() || a.idx.len() != b.idx.len() || !(0..b.len()).all(same) {
+                let k = (0..b.len()).find(|&k| !same(k)).unwrap_or(b.len());
+                return Some(format!(
+                    "the neighbours of particle {} differ from those the positions give",
+                    b.first + k
+                ));
+            }
+        }
+        None
     }
 
     /// Bytes held by the lists (capacity).

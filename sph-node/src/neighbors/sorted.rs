@@ -126,6 +126,25 @@ impl SortedCells {
         .sum::<usize>()
     }
 
+    /// The first field in which these bins (read back from a checkpoint) differ from `built`, the bins sorted again
+    /// from the same positions; `None` when they are the same. The counting sort's scratch (`old_cell`, `next`) is
+    /// left out: it is written before it is read.
+    pub fn differs_from(&self, built: &SortedCells) -> Option<&'static str> {
+        let (a, b) = (self, built);
+        [
+            ("grid", a.grid == b.grid),
+            ("fluid_start", a.fluid_start == b.fluid_start),
+            ("fluid_cell", a.fluid_cell == b.fluid_cell),
+            ("wall_bounds", a.wall_bounds == b.wall_bounds),
+            ("wall_grid", a.wall_grid == b.wall_grid),
+            ("wall_start", a.wall_start == b.wall_start),
+            ("wall_sorted", a.wall_sorted == b.wall_sorted),
+            ("wall_cell", a.wall_cell == b.wall_cell),
+        ]
+        .into_iter()
+        .find_map(|(field, same)| (!same).then_some(field))
+    }
+
     /// The grid of the last [`SortedCells::sort`].
     pub fn grid(&self) -> &Grid {
         &self.grid

@@ -1,0 +1,335 @@
+//! `broker.bin`: the coordinator's state between two steps ([`BrokerState`]), and the checks a restart runs on it
+//! before it is used. The file's checksum (`checkpoint.json`) catches a damaged copy; these checks catch a state
+//! that is intact but does not hold together (written by another tool, or by a build with a bug): every id the
+//! pending corrections name is a node or particle of the run, every probe row has a value per probe, the numbers
+//! the coordinator steps with are finite. Each refusal is one line naming the field, the index and the value.
+
+use cosim_proto::messages::Correction;
+use cosim_proto::scene::Scene;
+use serde::{Deserialize, Serialize};
+
+use crate::summary::Summary;
+
+/// The coordinator's state between two steps: what, with the nodes' states, makes the continued run the same.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BrokerState {
+    /// Coupling steps completed.
+    pub step: u64,
+    /// Simulated time [s].
+    pub t: f64,
+    /// Index of the next output time.
+    pub next_output: u64,
+    /// Index of the next checkpoint time.
+    pub next_checkpoint: u64,
+    /// The fluid's stable step last reported [s].
+    pub dt_fluid: f64,
+    /// Contact corrections of the last step, still to be sent to the structure node.
+    pub pending_fem: Vec<Correction>,
+    /// … and to the fluid node.
+    pub pending_sph: Vec<Correction>,
+    /// Region of interest of the next fluid command.
+    pub roi: Option<[f64; 4]>,
+    /// Interface load of the last output step.
+    pub load: Option<Vec<[f64; 2]>>,
+    /// Fluid particles exchanged over the run.
+    pub exchanged: u64,
+    /// Fluid positions of the first sample (potential energy probes).
+    pub fluid_origin: Option<Vec<[f64; 2]>>,
+    /// Every probe row so far: time and values.
+    pub rows: Vec<(f64, Vec<f64>)>,
+    /// The summary's counters so far.
+    pub summary: Summary,
+}
+
+/// `Err(message)` unless `ok`.
+fn ensure(ok: bool, message: impl FnOnce() -> String) -> Result<(), String> {
+    if ok {
+        Ok(())
+    } else {
+        Err(message())
+    }
+}
+
+/// Whether every component is finite.
+fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+impl BrokerState {
+    /// Check the state against itself and against `scene` (the scene the restart runs, which the checkpoint's
+    /// `scene.toml` was already found equal to): what can be known before any node is started. The sizes of the
+    /// nodes are those the saved summary recorded (`fem_nodes`, `particles`); the structure's is the scene's own,
+    /// the fluid's is compared with the fluid node's registration by [`BrokerState::check_nodes`].
+    /// `Err` is one line naming the field, the index and the value.
+    pub fn check(&self, scene: &Scene) -> Result<(), String> {
+        let s = &self.summary;
+        ensure(self.t.is_finite() && self.t >= 0.0, || {
+            format!("t = {} is not a time", self.t)
+        })?;
+        ensure(s.steps == self.step, || {
+            format!("summary.steps = {} where step = {}", s.steps, self.step)
+        })?;
+        ensure(s.sim_time.to_bits() == self.t.to_bits(), || {
+            format!("summary.sim_time = {} where t = {}", s.sim_time, self.t)
+        })?;
+        // A step of 0 or less (or NaN, which `min` passes over) would never reach the end: the run would hang.
+        ensure(self.dt_fluid > 0.0, || {
+            format!("dt_fluid = {} is not a positive step", self.dt_fluid)
+        })?;
+        let interval = scene.run.output_interval;
+        // Every output time up to `t` is sampled, so the next one lies after it.
+        ensure(
+            self.next_output >= 1 && self.next_output as f64 * interval > self.t,
+            || {
+                format!(
+                    "next_output = {}: output time {} s is not after t = {} s",
+                    self.next_output,
+                    self.next_output as f64 * interval,
+                    self.t
+                )
+            },
+        )?;
+        let fem_nodes: u64 = scene
+            .solids
+            .iter()
+            .map(|solid| solid.grid_size().iter().map(|&n| n as u64).product::<u64>())
+            .sum();
+        ensure(s.fem_nodes == fem_nodes, || {
+            format!(
+                "summary.fem_nodes = {} where the scene's solids have {fem_nodes} nodes",
+                s.fem_nodes
+            )
+        })?;
+        let particles = match scene.fluid {
+            Some(_) => s.particles,
+            None => 0,
+        };
+        ensure(s.particles == particles, || {
+            format!("summary.particles = {} but the scene has no fluid", s.particles)
+        })?;
+        check_corrections("pending_fem", &self.pending_fem, fem_nodes, "structure nodes")?;
+        check_corrections("pending_sph", &self.pending_sph, particles, "fluid particles")?;
+        if let Some(roi) = self.roi {
+            ensure(!roi.iter().any(|x| x.is_nan()), || format!("roi = {roi:?} holds NaN"))?;
+        }
+        if let Some(load) = &self.load {
+            ensure(load.len() as u64 == fem_nodes, || {
+                format!("load holds {} nodes, the structure has {fem_nodes}", load.len())
+            })?;
+            if let Some(k) = load.iter().position(|l| !finite(l)) {
+                return Err(format!("load[{k}] = {:?} is not finite", load[k]));
+            }
+        }
+        if let Some(x0) = &self.fluid_origin {
+            ensure(x0.len() as u64 == particles, || {
+                format!(
+                    "fluid_origin holds {} positions, the fluid has {particles} particles",
+                    x0.len()
+                )
+            })?;
+            if let Some(k) = x0.iter().position(|x| !finite(x)) {
+                return Err(format!("fluid_origin[{k}] = {:?} is not finite", x0[k]));
+            }
+        }
+        let probes = scene.probes.len();
+        let mut last = f64::NEG_INFINITY;
+        for (k, (t, values)) in self.rows.iter().enumerate() {
+            ensure(t.is_finite() && *t >= last && *t <= self.t, || {
+                format!(
+                    "rows[{k}]: t = {t} is not after the row before ({last}) and at most t = {}",
+                    self.t
+                )
+            })?;
+            ensure(values.len() == probes, || {
+                format!("rows[{k}] holds {} values, the scene has {probes} probes", values.len())
+            })?;
+            last = *t;
+        }
+        // One frame set and one probe row per output time: the frames written next are numbered from here.
+        let rows = self.rows.len() as u64;
+        ensure(s.samples == rows && s.frames == rows, || {
+            format!(
+                "summary.samples = {} and summary.frames = {} where rows holds {rows}",
+                s.samples, s.frames
+            )
+        })?;
+        Ok(())
+    }
+
+    /// Check the sizes the saved summary recorded against the nodes of the continued run, once they registered
+    /// (`fem_nodes`, `particles` as the run's summary counts them): the ids of the pending corrections and the
+    /// fluid origin were checked against the saved sizes by [`BrokerState::check`].
+    pub fn check_nodes(&self, fem_nodes: u64, particles: u64) -> anyhow::Result<()> {
+        let s = &self.summary;
+        anyhow::ensure!(
+            s.fem_nodes == fem_nodes && s.particles == particles,
+            "the checkpoint's broker.bin was saved with {} structure nodes and {} fluid particles, the nodes of this \
+             run have {fem_nodes} and {particles}",
+            s.fem_nodes,
+            s.particles
+        );
+        Ok(())
+    }
+}
+
+/// Every correction names one of `count` ids (`what`) and moves it by finite amounts.
+fn check_corrections(field: &str, corrections: &[Correction], count: u64, what: &str) -> Result<(), String> {
+    for (k, c) in corrections.iter().enumerate() {
+        ensure(u64::from(c.id) < count, || {
+            format!("{field}[{k}].id = {}, but there are {count} {what}", c.id)
+        })?;
+        ensure(finite(&c.dx) && finite(&c.dv), || {
+            format!(
+                "{field}[{k}] (id {}): dx {:?}, dv {:?} are not finite",
+                c.id, c.dx, c.dv
+            )
+        })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::summary::{ContactStats, Timings};
+
+    /// A coupled scene: one 2 × 1 quad solid (6 nodes), a fluid block, one probe.
+    fn scene() -> Scene {
+        let text = r#"
+version = 1
+[run]
+name = "t"
+end_time = 1.0
+output_interval = 0.1
+gravity = [0.0, -9.81]
+[fluid]
+density = 1000.0
+spacing = 0.1
+sound_speed = 20.0
+[[fluid.block]]
+min = [0.0, 0.0]
+max = [0.4, 0.4]
+[[wall]]
+min = [-0.2, -0.2]
+max = [2.0, 0.0]
+[[solid]]
+name = "s"
+min = [1.0, 0.0]
+max = [1.2, 0.1]
+divisions = [2, 1]
+material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, poisson_ratio = 0.3 }
+[[probe]]
+name = "front"
+kind = "surge_front"
+component = "x"
+"#;
+        cosim_proto::scene::parse("t.toml", text, &[]).unwrap()
+    }
+
+    fn state() -> BrokerState {
+        BrokerState {
+            step: 10,
+            t: 0.25,
+            next_output: 3,
+            next_checkpoint: 2,
+            dt_fluid: 1e-3,
+            pending_fem: vec![Correction {
+                id: 5,
+                dx: [0.0, 1e-4],
+                dv: [0.0; 2],
+            }],
+            pending_sph: vec![Correction {
+                id: 15,
+                dx: [1e-4, 0.0],
+                dv: [0.1, 0.0],
+            }],
+            roi: Some([0.9, -0.1, 1.3, 0.2]),
+            load: Some(vec![[0.0; 2]; 6]),
+            exchanged: 40,
+            fluid_origin: Some(vec![[0.05, 0.05]; 16]),
+            rows: vec![(0.0, vec![0.4]), (0.1, vec![0.45]), (0.2, vec![0.5])],
+            summary: Summary {
+                status: "ok".into(),
+                message: String::new(),
+                run_id: "r".into(),
+                scene: "t".into(),
+                steps: 10,
+                fem_substeps: 100,
+                sph_substeps: 10,
+                sim_time: 0.25,
+                wall_seconds: 1.0,
+                particles: 16,
+                fem_nodes: 6,
+                fem_elements: 2,
+                solver: "wcsph".into(),
+                contact: "node_to_segment".into(),
+                mode: "in-process".into(),
+                frames: 3,
+                samples: 3,
+                timings: Timings::default(),
+                contact_stats: ContactStats::default(),
+                counts: Default::default(),
+            },
+        }
+    }
+
+    /// The refusal of `state` after `edit`.
+    fn refused(edit: impl FnOnce(&mut BrokerState)) -> String {
+        let mut s = state();
+        edit(&mut s);
+        s.check(&scene()).expect_err("an inconsistent state is refused")
+    }
+
+    #[test]
+    fn a_consistent_state_passes() {
+        assert_eq!(state().check(&scene()), Ok(()));
+        assert!(state().check_nodes(6, 16).is_ok());
+    }
+
+    #[test]
+    fn ids_out_of_range_are_refused_naming_the_field() {
+        let e = refused(|s| s.pending_sph[0].id = 16);
+        assert_eq!(e, "pending_sph[0].id = 16, but there are 16 fluid particles");
+        let e = refused(|s| s.pending_fem[0].id = 6);
+        assert_eq!(e, "pending_fem[0].id = 6, but there are 6 structure nodes");
+        let e = refused(|s| s.pending_fem[0].dv = [f64::NAN, 0.0]);
+        assert!(e.starts_with("pending_fem[0] (id 5)") && e.contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn lengths_that_disagree_are_refused_naming_the_field() {
+        let e = refused(|s| s.rows[1].1.push(0.0));
+        assert_eq!(e, "rows[1] holds 2 values, the scene has 1 probes");
+        let e = refused(|s| {
+            s.load.as_mut().unwrap().pop();
+        });
+        assert_eq!(e, "load holds 5 nodes, the structure has 6");
+        let e = refused(|s| s.fluid_origin = Some(vec![[0.0; 2]; 17]));
+        assert_eq!(e, "fluid_origin holds 17 positions, the fluid has 16 particles");
+        let e = refused(|s| s.summary.fem_nodes = 9);
+        assert_eq!(e, "summary.fem_nodes = 9 where the scene's solids have 6 nodes");
+        let e = refused(|s| s.rows.push((0.25, vec![0.5])));
+        assert_eq!(e, "summary.samples = 3 and summary.frames = 3 where rows holds 4");
+        let e = state().check_nodes(6, 17).unwrap_err().to_string();
+        assert!(e.contains("16 fluid particles") && e.contains("have 6 and 17"), "{e}");
+    }
+
+    #[test]
+    fn numbers_that_would_stall_or_poison_the_run_are_refused() {
+        for dt in [0.0, -1e-3, f64::NAN] {
+            let e = refused(|s| s.dt_fluid = dt);
+            assert_eq!(e, format!("dt_fluid = {dt} is not a positive step"));
+        }
+        let e = refused(|s| s.next_output = 2);
+        assert!(
+            e.starts_with("next_output = 2: output time 0.2 s is not after t = 0.25 s"),
+            "{e}"
+        );
+        let e = refused(|s| s.rows[2].0 = f64::NAN);
+        assert!(e.starts_with("rows[2]: t = NaN"), "{e}");
+        let e = refused(|s| s.t = f64::INFINITY);
+        assert_eq!(e, "t = inf is not a time");
+        let e = refused(|s| s.summary.steps = 11);
+        assert_eq!(e, "summary.steps = 11 where step = 10");
+    }
+}

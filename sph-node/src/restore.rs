@@ -1,0 +1,211 @@
+//! Checks on a fluid solver read back from a checkpoint (`docs/PROTOCOL.md` §9), before the node continues from it.
+//!
+//! A checkpoint holds the whole solver, caches included, so that the continued run computes the same bits. The
+//! folder's checksums catch a damaged copy; these checks catch a state that is intact but does not hold together,
+//! from another tool or a build with a bug, which would otherwise panic on an index or run on silently wrong:
+//! - what follows from the scene (parameters, kernel, walls, masses, particle count) equals what the scene gives;
+//! - every per-particle array has one entry per particle, and the numbers a step starts from are finite;
+//! - id maps are permutations, and copies of the state agree with it bit for bit;
+//! - the caches built from the positions (cell order, cell bins, neighbour lists) are those the positions give:
+//!   they are built again and compared.
+//!
+//! Each solver checks its own fields ([`crate::WcsphSolver`], [`crate::IsphSolver`]) with the helpers here. A
+//! refusal is one line naming the field, the index and the value.
+
+use std::fmt::Debug;
+
+use crate::particles::{FluidState, WallParticles};
+
+/// `Err` is the refusal: one line naming the field, the index and the value.
+pub(crate) type Check = Result<(), String>;
+
+/// `values` holds `n` entries.
+pub(crate) fn len<T>(field: &str, values: &[T], n: usize, what: &str) -> Check {
+    if values.len() == n {
+        Ok(())
+    } else {
+        Err(format!("{field} holds {} entries, there are {n} {what}", values.len()))
+    }
+}
+
+/// Every entry of `values` is finite.
+pub(crate) fn finite(field: &str, values: &[f64]) -> Check {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(format!("{field}[{k}] = {} is not finite", values[k])),
+    }
+}
+
+/// Every vector of `values` is finite.
+pub(crate) fn finite2(field: &str, values: &[[f64; 2]]) -> Check {
+    match values.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+        None => Ok(()),
+        Some(k) => Err(format!("{field}[{k}] = {:?} is not finite", values[k])),
+    }
+}
+
+/// `saved` equals what the scene gives (`scene`).
+pub(crate) fn same<T: PartialEq + Debug>(field: &str, saved: &T, scene: &T) -> Check {
+    if saved == scene {
+        Ok(())
+    } else {
+        Err(format!("{field} = {saved:?} where the scene gives {scene:?}"))
+    }
+}
+
+/// `saved` equals `want` bit for bit (same length, then every entry).
+pub(crate) fn same_bits<T: Bits + Debug>(field: &str, saved: &[T], want: &[T], of: &str) -> Check {
+    if saved.len() != want.len() {
+        return Err(format!(
+            "{field} holds {} entries where {of} has {}",
+            saved.len(),
+            want.len()
+        ));
+    }
+    match saved.iter().zip(want).position(|(a, b)| a.bits() != b.bits()) {
+        None => Ok(()),
+        Some(k) => Err(format!("{field}[{k}] = {:?} where {of} has {:?}", saved[k], want[k])),
+    }
+}
+
+/// Values compared bit for bit (so that NaN is refused where a number is expected, and −0 is told from +0).
+pub(crate) trait Bits {
+    /// The bit pattern.
+    fn bits(&self) -> [u64; 2];
+}
+
+impl Bits for f64 {
+    fn bits(&self) -> [u64; 2] {
+        [self.to_bits(), 0]
+    }
+}
+
+impl Bits for [f64; 2] {
+    fn bits(&self) -> [u64; 2] {
+        self.map(f64::to_bits)
+    }
+}
+
+/// `ids` (slot → id) and `slot` (id → slot) are inverse permutations of `0..n`.
+pub(crate) fn permutation(ids_field: &str, ids: &[u32], slot_field: &str, slot: &[u32], n: usize) -> Check {
+    len(ids_field, ids, n, "fluid particles")?;
+    len(slot_field, slot, n, "fluid particles")?;
+    for (id, &k) in slot.iter().enumerate() {
+        match ids.get(k as usize) {
+            Some(&back) if back as usize == id => {}
+            Some(&back) => return Err(format!("{slot_field}[{id}] = {k} but {ids_field}[{k}] = {back}")),
+            None => return Err(format!("{slot_field}[{id}] = {k} is not a slot ({n} fluid particles)")),
+        }
+    }
+    // `slot` maps 0..n into 0..n one to one (each slot sends its id back), so `ids` is its inverse.
+    Ok(())
+}
+
+/// The fluid particles: as many as the scene makes, their masses the scene's (a particle's mass never changes),
+/// every array one entry per particle, positions, velocities, densities and pressures finite, densities positive.
+pub(crate) fn check_state(state: &FluidState, scene: &FluidState) -> Check {
+    let n = scene.len();
+    let what = "fluid particles";
+    if !(state.t.is_finite() && state.t >= 0.0) {
+        return Err(format!("state.t = {} is not a time", state.t));
+    }
+    len("state.x", &state.x, n, what)?;
+    len("state.v", &state.v, n, what)?;
+    len("state.rho", &state.rho, n, what)?;
+    len("state.p", &state.p, n, what)?;
+    same_bits("state.m", &state.m, &scene.m, "the scene")?;
+    finite2("state.x", &state.x)?;
+    finite2("state.v", &state.v)?;
+    finite("state.p", &state.p)?;
+    match state.rho.iter().position(|r| !(r.is_finite() && *r > 0.0)) {
+        None => Ok(()),
+        Some(k) => Err(format!("state.rho[{k}] = {} is not a positive density", state.rho[k])),
+    }
+}
+
+/// The wall particles: where the scene puts them, with its masses, and a finite pressure and positive density each.
+pub(crate) fn check_walls(walls: &WallParticles, scene: &WallParticles) -> Check {
+    same_bits("walls.x", &walls.x, &scene.x, "the scene")?;
+    same_bits("walls.m", &walls.m, &scene.m, "the scene")?;
+    let (n, what) = (scene.len(), "wall particles");
+    len("walls.p", &walls.p, n, what)?;
+    len("walls.rho", &walls.rho, n, what)?;
+    finite("walls.p", &walls.p)?;
+    match walls.rho.iter().position(|r| !(r.is_finite() && *r > 0.0)) {
+        None => Ok(()),
+        Some(k) => Err(format!("walls.rho[{k}] = {} is not a positive density", walls.rho[k])),
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use cosim_proto::scene::Scene;
+
+    /// A small dam break (200 particles, Δx = 1 cm) for `fluid.solver` = `solver`, with a tank of walls 3Δx thick,
+    /// and the scene overrides `sets` (`key=value`).
+    pub(crate) fn tank(solver: &str, sets: &[&str]) -> Scene {
+        let text = format!(
+            r#"
+version = 1
+[run]
+name = "tank"
+end_time = 1.0
+output_interval = 0.1
+gravity = [0.0, -9.81]
+[fluid]
+solver = "{solver}"
+density = 1000.0
+spacing = 0.01
+[[fluid.block]]
+min = [0.0, 0.0]
+max = [0.1, 0.2]
+[[wall]]
+min = [-0.03, -0.03]
+max = [0.43, 0.0]
+[[wall]]
+min = [-0.03, 0.0]
+max = [0.0, 0.3]
+[[wall]]
+min = [0.4, 0.0]
+max = [0.43, 0.3]
+"#
+        );
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        cosim_proto::scene::parse("tank.toml", &text, &sets).expect("a valid scene")
+    }
+
+    #[test]
+    fn permutations_are_checked_both_ways() {
+        assert_eq!(permutation("ids", &[2, 0, 1], "slot", &[1, 2, 0], 3), Ok(()));
+        assert_eq!(
+            permutation("ids", &[2, 0, 1], "slot", &[1, 2, 7], 3),
+            Err("slot[2] = 7 is not a slot (3 fluid particles)".into())
+        );
+        assert_eq!(
+            permutation("ids", &[2, 0, 0], "slot", &[1, 2, 0], 3),
+            Err("slot[1] = 2 but ids[2] = 0".into())
+        );
+        assert_eq!(
+            permutation("ids", &[0, 1], "slot", &[0, 1, 2], 3),
+            Err("ids holds 2 entries, there are 3 fluid particles".into())
+        );
+    }
+
+    #[test]
+    fn bits_tell_nan_and_signed_zero() {
+        assert_eq!(same_bits("a", &[1.0, 2.0], &[1.0, 2.0], "b"), Ok(()));
+        assert_eq!(
+            same_bits("a", &[1.0, -0.0], &[1.0, 0.0], "b"),
+            Err("a[1] = -0.0 where b has 0.0".into())
+        );
+        assert_eq!(
+            same_bits("a", &[[f64::NAN, 0.0]], &[[0.0, 0.0]], "b"),
+            Err("a[0] = [NaN, 0.0] where b has [0.0, 0.0]".into())
+        );
+        assert_eq!(
+            same_bits("a", &[1.0], &[], "b"),
+            Err("a holds 1 entries where b has 0".into())
+        );
+    }
+}
