@@ -142,13 +142,14 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     ) -> anyhow::Result<Self> {
         let topics = subs.topics;
         let deadline = Instant::now() + wait;
+        // The last registration refused, kept over the whole wait: when no good one comes, it is the reason.
+        let mut refused: Option<String> = None;
         let setup = loop {
             let got = subs
                 .setup
                 .recv_timeout(Duration::from_millis(50))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
             // A registration that does not decode as this run's is refused: logged, and the wait goes on.
-            let mut refused = None;
             if let Some(sample) = got {
                 match Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup) {
                     Ok(env) => break env.body,
