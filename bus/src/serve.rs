@@ -206,7 +206,8 @@ fn serve_session<C: NodeCore>(
         });
     }
     board.update(|s| s.counts = counts_of(&core));
-    let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
+    // Every message is sized before it is sent: zenoh drops one over 1 GiB without a word (`MAX_SEND_BYTES`).
+    let setup = Envelope::new(run, 0, 0.0, core.setup()).encode_checked(topics.setup)?;
     session
         .put(key(run, topics.setup), setup)
         .congestion_control(CongestionControl::Block)
@@ -226,8 +227,10 @@ fn serve_session<C: NodeCore>(
                         node: topics.name.into(),
                         data,
                     };
-                    let bytes = Envelope::new(run, expected.saturating_sub(1), t, body).encode();
-                    query.reply(query.key_expr().clone(), bytes).wait()
+                    match Envelope::new(run, expected.saturating_sub(1), t, body).encode_checked(topics.checkpoint) {
+                        Ok(bytes) => query.reply(query.key_expr().clone(), bytes).wait(),
+                        Err(e) => query.reply_err(e.to_string()).wait(),
+                    }
                 }
                 None => query.reply_err("this node cannot save a checkpoint").wait(),
             };
@@ -285,7 +288,7 @@ fn serve_session<C: NodeCore>(
         board.update(|s| s.counts = counts_of(&core));
         idle_since = std::time::Instant::now();
         // A shared buffer: keeping it to answer a repeat costs no copy.
-        let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode());
+        let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode_checked(topics.state)?);
         state_pub.put(answer.clone()).wait().map_err(zerr)?;
         last = Some((bytes.into_owned(), answer));
         // After the answer, off the step's critical path.

@@ -49,7 +49,7 @@ pub fn serve_restore(
         node: topics.name.into(),
         data,
     };
-    let bytes = Envelope::new(run, step, t, body).encode();
+    let bytes = Envelope::new(run, step, t, body).encode_checked(topics.restore)?;
     session
         .declare_queryable(key(run, topics.restore))
         .callback(move |query| {
@@ -238,7 +238,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
         // A shared buffer: keeping it to send again costs no copy.
-        let bytes = ZBytes::from(Envelope::new(&self.run, step, t, cmd).encode());
+        let bytes = Envelope::new(&self.run, step, t, cmd)
+            .encode_checked(self.topics.command)
+            .map_err(|e| self.failed(e.to_string()))?;
+        let bytes = ZBytes::from(bytes);
         self.command
             .put(bytes.clone())
             .wait()
