@@ -117,6 +117,9 @@ pub fn serve<C: NodeCore>(
     }
     .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
     let run = opts.run.as_str();
+    // A run id claims its key space (`crate::claim`): a second node of this kind on a live run is refused before
+    // it declares anything there, and reports nothing on the run's error topic (the run is fine without it).
+    crate::claim::ensure_free(&session, run, topics.alive, topics.name)?;
     // Live status (`cosim inspect`), answered from the start; a failure is written on it before the exit.
     let board = Board::new(topics.name, run);
     let _status = serve_status(&session, key(run, topics.status), board.clone())?;
@@ -341,18 +344,33 @@ fn fetch_restore(
     Ok((!env.body.data.is_empty()).then_some(env))
 }
 
+/// The scene from the run's broker. Every answer is collected (consolidation off: zenoh would otherwise keep one
+/// answer per key), and a run answered by more than one broker is refused ([`crate::claim::Ambiguous`]): two runs
+/// on one run id that started within the moment the brokers' own check cannot see.
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
+    let scene_key = key(run, topic::SCENE);
     let replies = session
-        .get(key(run, topic::SCENE))
+        .get(&scene_key)
+        .consolidation(zenoh::query::ConsolidationMode::None)
         .timeout(timeout)
         .wait()
         .map_err(zerr)?;
-    match replies.recv() {
-        Ok(reply) => match reply.result() {
+    // The channel closes once every queryable answered (or at the timeout).
+    let answers: Vec<_> = std::iter::from_fn(|| replies.recv().ok()).collect();
+    if answers.len() > 1 {
+        return Err(crate::claim::Ambiguous {
+            run: run.into(),
+            brokers: answers.len(),
+            key: scene_key,
+        }
+        .into());
+    }
+    match answers.into_iter().next() {
+        Some(reply) => match reply.result() {
             Ok(sample) => Ok(String::from_utf8(sample.payload().to_bytes().into_owned())?),
             Err(e) => anyhow::bail!("the broker refused the scene query: {e:?}"),
         },
-        Err(_) => anyhow::bail!(
+        None => anyhow::bail!(
             "no broker of run {run} answered within {:.0} s (is `--run` right?)",
             timeout.as_secs_f64()
         ),
