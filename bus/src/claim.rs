@@ -7,7 +7,9 @@
 //!
 //! Zenoh answers a liveliness query from its table of declared tokens (the router's, through a router), so the
 //! check costs one round trip. What it cannot see is a process that declares its token between this check and its
-//! own declaration, milliseconds later: see [`crate::serve`] for what a node checks besides.
+//! own declaration, milliseconds later; nor, in peer mode (every process connected to the broker, no router), the
+//! token of another node: a peer answers for its own tokens only. So a node also asks the broker's status
+//! ([`ensure_not_started`]), and refuses a run served by two brokers (`crate::serve`).
 
 use std::time::Duration;
 
@@ -57,10 +59,60 @@ pub fn ensure_free(session: &Session, run: &str, alive: &str, who: &str) -> anyh
     Ok(())
 }
 
-/// Whether `e` is a refusal by [`ensure_free`] (or by a node that found its run served by two brokers), anywhere
-/// in its chain of causes.
+/// Whether `e` is a refusal by [`ensure_free`] or [`ensure_not_started`] (or by a node that found its run served by
+/// two brokers), anywhere in its chain of causes.
 pub fn is_refusal(e: &anyhow::Error) -> bool {
-    e.chain().any(|c| c.is::<Taken>() || c.is::<Ambiguous>())
+    e.chain()
+        .any(|c| c.is::<Taken>() || c.is::<Started>() || c.is::<Ambiguous>())
+}
+
+/// The run's broker is past the registration of its nodes: a node that joins now is not one it waits for.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "run `{run}` is under way already (its contact-broker's status, {key}, says `{health}`): refusing to join it as \
+     another {who}"
+)]
+pub struct Started {
+    /// The run id.
+    pub run: String,
+    /// The node refused.
+    pub who: String,
+    /// The broker's status key.
+    pub key: String,
+    /// The health the broker reported.
+    pub health: String,
+}
+
+/// Refuse (with [`Started`]) to join run `run` as `who` when its broker's live status (`crate::status`) says that it
+/// no longer waits for its nodes (health other than `starting`). This sees what [`ensure_free`] cannot in peer mode:
+/// the broker answers its status itself. A broker that does not answer (none yet, or a program of another kind) is
+/// no reason to refuse.
+pub fn ensure_not_started(session: &Session, run: &str, who: &str) -> anyhow::Result<()> {
+    let key = key(run, cosim_proto::keys::topic::BROKER_STATUS);
+    let replies = session
+        .get(&key)
+        .timeout(CLAIM_TIMEOUT)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot ask for the status of run `{run}` ({key}): {e}"))?;
+    while let Ok(reply) = replies.recv() {
+        let Ok(sample) = reply.result() else { continue };
+        let status: Option<serde_json::Value> = serde_json::from_slice(&sample.payload().to_bytes()).ok();
+        let health = status
+            .as_ref()
+            .and_then(|s| s.get("health"))
+            .and_then(|h| h.as_str())
+            .unwrap_or("starting");
+        if health != "starting" {
+            return Err(Started {
+                run: run.into(),
+                who: who.into(),
+                key,
+                health: health.into(),
+            }
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// A node found its run served by more than one broker: two runs on one run id started within the moment

@@ -120,6 +120,7 @@ pub fn serve<C: NodeCore>(
     // A run id claims its key space (`crate::claim`): a second node of this kind on a live run is refused before
     // it declares anything there, and reports nothing on the run's error topic (the run is fine without it).
     crate::claim::ensure_free(&session, run, topics.alive, topics.name)?;
+    crate::claim::ensure_not_started(&session, run, topics.name)?;
     // Live status (`cosim inspect`), answered from the start; a failure is written on it before the exit.
     let board = Board::new(topics.name, run);
     let _status = serve_status(&session, key(run, topics.status), board.clone())?;

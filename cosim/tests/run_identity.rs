@@ -30,16 +30,35 @@ fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
-/// Assert that `output` is a refusal of run `id`: exit code 2, one line on stderr naming the run id and `what`.
+/// Assert that `output` is a refusal of run `id`: exit code 2, and its last line on stderr (the only one but for
+/// zenoh's own warnings) names the run id and `what`.
 fn assert_refused(output: &Output, id: &str, what: &str) {
     let text = stderr(output);
     assert_eq!(output.status.code(), Some(2), "{what}: {text}");
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "{what}: one line expected: {text}");
+    let (last, before) = lines.split_last().unwrap_or((&"", &[]));
     assert!(
-        lines[0].contains(&format!("run `{id}`")) && lines[0].contains(what),
+        before.iter().all(|l| l.contains("WARN") && l.contains("zenoh")),
+        "{what}: one line expected: {text}"
+    );
+    assert!(
+        last.contains(&format!("run `{id}`")) && last.contains(what),
         "{what}: {text}"
     );
+}
+
+/// Probes of the scene run alone in one process: the reference of every run here.
+fn alone(dir: &Path) -> Vec<u8> {
+    let out = dir.join("alone");
+    let run = run_bounded(
+        Command::new(cosim())
+            .current_dir(root())
+            .args(["run", SCENE, "--quiet", "--set", END, "--in-process", "--out"])
+            .arg(&out),
+        LIMIT,
+    );
+    assert!(run.status.success(), "{}", stderr(&run));
+    std::fs::read(out.join("probes.csv")).unwrap()
 }
 
 #[test]
@@ -48,12 +67,7 @@ fn a_live_run_id_refuses_a_second_broker_and_node_and_runs_on_undisturbed() {
     let hub = format!("tcp/127.0.0.1:{}", free_port());
     let (_router, _) = start_router(&hub, None, &dir.join("router.stderr"));
     let id = run_id("identity");
-    let (first, second, by_hand, alone) = (
-        dir.join("first"),
-        dir.join("second"),
-        dir.join("by_hand"),
-        dir.join("alone"),
-    );
+    let (first, second, by_hand) = (dir.join("first"), dir.join("second"), dir.join("by_hand"));
 
     let mut run = Kill(
         Command::new(cosim())
@@ -143,19 +157,53 @@ fn a_live_run_id_refuses_a_second_broker_and_node_and_runs_on_undisturbed() {
     assert_eq!(json(&first.join("summary.json"))["status"], "ok");
 
     // The same run alone, in one process: the same probes, byte for byte.
-    let out = run_bounded(
+    let probes = std::fs::read(first.join("probes.csv")).unwrap();
+    assert!(probes.len() > 1000);
+    assert!(
+        probes == alone(&dir),
+        "the first run's probes differ from its run alone"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_node_is_refused_by_a_run_under_way_in_peer_mode() {
+    // Peer to peer (no router): a peer answers for its own liveliness tokens only, so the second node cannot see
+    // the first one's; the broker's status says that the run no longer waits for nodes.
+    let dir = scratch("run-identity-peer");
+    let id = run_id("identity-peer");
+    let first = dir.join("first");
+    let mut run = Kill(
         Command::new(cosim())
             .current_dir(root())
-            .args(["run", SCENE, "--quiet", "--set", END, "--in-process", "--out"])
-            .arg(&alone),
-        LIMIT,
+            .env("COSIM_BIN_DIR", bin_dir())
+            .args(["run", SCENE, "--quiet", "--set", END, "--run-id", &id, "--out"])
+            .arg(&first)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(dir.join("first.stderr")).unwrap())
+            .spawn()
+            .unwrap(),
     );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let probes = |d: &Path| std::fs::read(d.join("probes.csv")).unwrap();
-    assert!(probes(&first).len() > 1000);
+    wait_for_samples(&mut run.0, &first, 2, LIMIT);
+    // Where `cosim inspect` finds the run: the broker's endpoint.
+    let registry = std::env::temp_dir().join("cosim-runs").join(format!("{id}.json"));
+    let endpoint = json(&registry)["connect"].as_str().unwrap().to_string();
+    let out = run_bounded(
+        Command::new(program("fem-node")).args(["--run", &id, "--connect", &endpoint]),
+        REFUSE_LIMIT,
+    );
+    assert_refused(&out, &id, "is under way already");
     assert!(
-        probes(&first) == probes(&alone),
-        "the first run's probes differ from its run alone"
+        run.0.try_wait().unwrap().is_none(),
+        "the run ended before the check was done: make it longer"
+    );
+    let status = wait_exit(&mut run.0, Instant::now() + LIMIT, "the run");
+    let said = std::fs::read_to_string(dir.join("first.stderr")).unwrap_or_default();
+    assert!(status.success(), "the run failed: {said}");
+    assert!(
+        std::fs::read(first.join("probes.csv")).unwrap() == alone(&dir),
+        "the run's probes differ from its run alone"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
