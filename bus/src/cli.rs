@@ -37,20 +37,18 @@ struct Args {
     zenoh_config: Option<PathBuf>,
 }
 
-/// The whole `main` of a node binary: parse the arguments, serve, and exit non-zero with one line on stderr.
+/// The whole `main` of a node binary: parse the arguments, serve, and exit non-zero with one line on stderr (2 for a
+/// run that refuses it, `crate::claim`; 1 for any other failure).
 pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> Result<C, Failure>) -> ! {
-    tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
-        .with_writer(std::io::stderr)
-        .init();
+    crate::log::init();
     let args = Args::parse();
-    let fail = |message: String| -> ! {
-        eprintln!("{}: {}", topics.name, message.replace('\n', " "));
-        std::process::exit(1)
+    let fail = |message: String, code: i32| -> ! {
+        crate::log::say(&format!("{}: {}", topics.name, message.replace('\n', " ")));
+        std::process::exit(code)
     };
     if let Some(n) = args.threads {
         if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
-            fail(format!("--threads {n}: {e}"));
+            fail(format!("--threads {n}: {e}"), 1);
         }
     }
     let opts = NodeOptions {
@@ -63,6 +61,7 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
     };
     match serve(&opts, topics, build) {
         Ok(()) => std::process::exit(0),
-        Err(e) => fail(format!("{e:#}")),
+        // A run id that is taken (`crate::claim`) is refused input, as for `cosim run`: exit code 2.
+        Err(e) => fail(format!("{e:#}"), if crate::claim::is_refusal(&e) { 2 } else { 1 }),
     }
 }

@@ -117,6 +117,10 @@ pub fn serve<C: NodeCore>(
     }
     .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
     let run = opts.run.as_str();
+    // A run id claims its key space (`crate::claim`): a second node of this kind on a live run is refused before
+    // it declares anything there, and reports nothing on the run's error topic (the run is fine without it).
+    crate::claim::ensure_free(&session, run, topics.alive, topics.name)?;
+    crate::claim::ensure_not_started(&session, run, topics.name)?;
     // Live status (`cosim inspect`), answered from the start; a failure is written on it before the exit.
     let board = Board::new(topics.name, run);
     let _status = serve_status(&session, key(run, topics.status), board.clone())?;
@@ -206,7 +210,8 @@ fn serve_session<C: NodeCore>(
         });
     }
     board.update(|s| s.counts = counts_of(&core));
-    let setup = Envelope::new(run, 0, 0.0, core.setup()).encode();
+    // Every message is sized before it is sent: zenoh drops one over 1 GiB without a word (`MAX_SEND_BYTES`).
+    let setup = Envelope::new(run, 0, 0.0, core.setup()).encode_checked(topics.setup)?;
     session
         .put(key(run, topics.setup), setup)
         .congestion_control(CongestionControl::Block)
@@ -226,8 +231,10 @@ fn serve_session<C: NodeCore>(
                         node: topics.name.into(),
                         data,
                     };
-                    let bytes = Envelope::new(run, expected.saturating_sub(1), t, body).encode();
-                    query.reply(query.key_expr().clone(), bytes).wait()
+                    match Envelope::new(run, expected.saturating_sub(1), t, body).encode_checked(topics.checkpoint) {
+                        Ok(bytes) => query.reply(query.key_expr().clone(), bytes).wait(),
+                        Err(e) => query.reply_err(e.to_string()).wait(),
+                    }
                 }
                 None => query.reply_err("this node cannot save a checkpoint").wait(),
             };
@@ -285,7 +292,7 @@ fn serve_session<C: NodeCore>(
         board.update(|s| s.counts = counts_of(&core));
         idle_since = std::time::Instant::now();
         // A shared buffer: keeping it to answer a repeat costs no copy.
-        let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode());
+        let answer = ZBytes::from(Envelope::new(run, env.step, t, state).encode_checked(topics.state)?);
         state_pub.put(answer.clone()).wait().map_err(zerr)?;
         last = Some((bytes.into_owned(), answer));
         // After the answer, off the step's critical path.
@@ -338,18 +345,33 @@ fn fetch_restore(
     Ok((!env.body.data.is_empty()).then_some(env))
 }
 
+/// The scene from the run's broker. Every answer is collected (consolidation off: zenoh would otherwise keep one
+/// answer per key), and a run answered by more than one broker is refused ([`crate::claim::Ambiguous`]): two runs
+/// on one run id that started within the moment the brokers' own check cannot see.
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
+    let scene_key = key(run, topic::SCENE);
     let replies = session
-        .get(key(run, topic::SCENE))
+        .get(&scene_key)
+        .consolidation(zenoh::query::ConsolidationMode::None)
         .timeout(timeout)
         .wait()
         .map_err(zerr)?;
-    match replies.recv() {
-        Ok(reply) => match reply.result() {
+    // The channel closes once every queryable answered (or at the timeout).
+    let answers: Vec<_> = std::iter::from_fn(|| replies.recv().ok()).collect();
+    if answers.len() > 1 {
+        return Err(crate::claim::Ambiguous {
+            run: run.into(),
+            brokers: answers.len(),
+            key: scene_key,
+        }
+        .into());
+    }
+    match answers.into_iter().next() {
+        Some(reply) => match reply.result() {
             Ok(sample) => Ok(String::from_utf8(sample.payload().to_bytes().into_owned())?),
             Err(e) => anyhow::bail!("the broker refused the scene query: {e:?}"),
         },
-        Err(_) => anyhow::bail!(
+        None => anyhow::bail!(
             "no broker of run {run} answered within {:.0} s (is `--run` right?)",
             timeout.as_secs_f64()
         ),

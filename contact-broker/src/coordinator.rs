@@ -155,7 +155,7 @@ pub fn run_with(
     }
     summary.wall_seconds = started.elapsed().as_secs_f64();
     if let Err(e) = write_summary(&info.out, &summary) {
-        tracing::error!("summary.json: {e:#}");
+        tracing::error!("{e:#}");
     }
     Outcome { summary, error }
 }
@@ -643,7 +643,7 @@ fn unusable(node: &str, e: Invalid) -> LinkError {
 
 fn plot_all(scene: &LoadedScene, out: &Path, series: &Series) -> anyhow::Result<()> {
     let dir = out.join("plots");
-    std::fs::create_dir_all(&dir)?;
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     for (spec, line) in scene.scene.probes.iter().zip(series) {
         let reference = spec.reference.as_ref().map(|r| (r, scene.resolve(&r.file)));
         let path = dir.join(format!("{}.svg", spec.name));
@@ -654,16 +654,14 @@ fn plot_all(scene: &LoadedScene, out: &Path, series: &Series) -> anyhow::Result<
             reference.as_ref().map(|(r, p)| (*r, p.as_path())),
         );
         if let Err(e) = result {
-            tracing::warn!("plot {}: {e:#}", path.display());
+            tracing::warn!("{e:#}");
         }
     }
     Ok(())
 }
 
-/// Write `summary.json` atomically (temporary file, then rename).
+/// Write `summary.json` in place over the room reserved for it when the run started (`crate::summary`), so that
+/// it is written however full the disk got; an error names the file.
 pub fn write_summary(out: &Path, summary: &Summary) -> anyhow::Result<()> {
-    let tmp = out.join("summary.json.tmp");
-    std::fs::write(&tmp, serde_json::to_string_pretty(summary)? + "\n")?;
-    std::fs::rename(&tmp, out.join("summary.json"))?;
-    Ok(())
+    Ok(crate::summary::write(out, summary)?)
 }

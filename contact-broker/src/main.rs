@@ -13,6 +13,7 @@ use clap::Parser;
 use contact_broker::checkpoint;
 use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
+use contact_broker::summary;
 use contact_broker::transport::{self, ZenohLink};
 use cosim_bus::interrupt::Interrupt;
 use cosim_bus::status::{serve_status, Board};
@@ -65,13 +66,12 @@ struct Args {
 }
 
 fn main() {
-    tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
-        .with_writer(std::io::stderr)
-        .init();
+    // Its stderr is a log file in the output folder: a disk that fills up loses log lines, never the broker.
+    cosim_bus::log::init();
     if let Err(e) = run(Args::parse()) {
-        eprintln!("contact-broker: {}", format!("{e:#}").replace('\n', " "));
-        std::process::exit(1);
+        cosim_bus::log::say(&format!("contact-broker: {}", format!("{e:#}").replace('\n', " ")));
+        // A run id that is live already is refused input (exit 2, as `cosim run` gives for bad input).
+        std::process::exit(if cosim_bus::claim::is_refusal(&e) { 2 } else { 1 });
     }
 }
 
@@ -84,6 +84,7 @@ fn emit(value: serde_json::Value) -> std::io::Result<()> {
 }
 
 fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
     anyhow::ensure!(
         valid_run_id(&args.run),
         "--run `{}`: use letters, digits, - and _ only",
@@ -97,7 +98,6 @@ fn run(args: Args) -> anyhow::Result<()> {
         Some(dir) => Some(checkpoint::open(dir, &scene)?),
         None => None,
     };
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     // From here on a signal stops the run between two steps instead of killing the broker mid-step.
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let base = args.zenoh_config.as_deref();
@@ -114,6 +114,41 @@ fn run(args: Args) -> anyhow::Result<()> {
             )
         })?,
     };
+    // A run id claims its key space (`cosim_bus::claim`): on a live run id this broker stops here, before it
+    // declares anything there or writes into the output folder (which may be the live run's).
+    cosim_bus::claim::ensure_free(&session, &args.run, topic::BROKER_ALIVE, "contact-broker")?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    // The room for summary.json, taken before anything else is written: a disk that fills up during the run
+    // still gets the summary that says so (`contact_broker::summary`).
+    summary::reserve(&args.out, &args.run, &args.mode)?;
+    // The body keeps a handle of the session (a shared one: cloning it opens nothing).
+    let result = serve(&args, &scene, restart, session.clone(), endpoints, &interrupt);
+    // A run that failed before the coordinator wrote its summary (a node that never registered): say why there.
+    if let Err(e) = &result {
+        let written = std::fs::read_to_string(args.out.join(summary::FILE))
+            .ok()
+            .and_then(|t| serde_json::from_str::<summary::Summary>(&t).ok())
+            .is_some_and(|s| !s.is_placeholder());
+        if !written {
+            let mut failed = summary::Summary::failed(&args.run, &args.mode, format!("{e:#}").replace('\n', " "));
+            failed.wall_seconds = started.elapsed().as_secs_f64();
+            if let Err(e) = summary::write(&args.out, &failed) {
+                cosim_bus::log::say(&format!("contact-broker: {e}"));
+            }
+        }
+    }
+    result
+}
+
+/// The run, from the declarations on its keys to its end.
+fn serve(
+    args: &Args,
+    scene: &cosim_proto::scene::LoadedScene,
+    restart: Option<checkpoint::Restart>,
+    session: zenoh::Session,
+    endpoints: Vec<String>,
+    interrupt: &Interrupt,
+) -> anyhow::Result<()> {
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
     let fem_subs = match scene.scene.solids.is_empty() {
         false => Some(transport::subscribe(&session, &args.run, cosim_proto::keys::FEM)?),
@@ -225,7 +260,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         interval: args.checkpoint_interval,
         restart: restart.map(|r| r.broker),
     };
-    let outcome = coordinator::run_with(&scene, nodes, &info, &plan, &mut report);
+    let outcome = coordinator::run_with(scene, nodes, &info, &plan, &mut report);
     board.update(|s| {
         s.health = if outcome.summary.status == "ok" {
             "finished"

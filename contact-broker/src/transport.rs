@@ -49,7 +49,7 @@ pub fn serve_restore(
         node: topics.name.into(),
         data,
     };
-    let bytes = Envelope::new(run, step, t, body).encode();
+    let bytes = Envelope::new(run, step, t, body).encode_checked(topics.restore)?;
     session
         .declare_queryable(key(run, topics.restore))
         .callback(move |query| {
@@ -142,13 +142,14 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     ) -> anyhow::Result<Self> {
         let topics = subs.topics;
         let deadline = Instant::now() + wait;
+        // The last registration refused, kept over the whole wait: when no good one comes, it is the reason.
+        let mut refused: Option<String> = None;
         let setup = loop {
             let got = subs
                 .setup
                 .recv_timeout(Duration::from_millis(50))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
             // A registration that does not decode as this run's is refused: logged, and the wait goes on.
-            let mut refused = None;
             if let Some(sample) = got {
                 match Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup) {
                     Ok(env) => break env.body,
@@ -237,7 +238,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
         // A shared buffer: keeping it to send again costs no copy.
-        let bytes = ZBytes::from(Envelope::new(&self.run, step, t, cmd).encode());
+        let bytes = Envelope::new(&self.run, step, t, cmd)
+            .encode_checked(self.topics.command)
+            .map_err(|e| self.failed(e.to_string()))?;
+        let bytes = ZBytes::from(bytes);
         self.command
             .put(bytes.clone())
             .wait()

@@ -44,6 +44,35 @@ pub fn find_program(name: &str) -> anyhow::Result<PathBuf> {
     })
 }
 
+/// `contact-broker` refused to start (exit code 2): the run id is live already (`cosim_bus::claim`).
+#[derive(Debug, thiserror::Error)]
+#[error("contact-broker refused to start: {0}")]
+pub struct BrokerRefused(String);
+
+/// Whether the run was refused (by the broker, or by [`ensure_run_id_free`]) rather than failed.
+pub fn is_refused(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.is::<BrokerRefused>()) || cosim_bus::claim::is_refusal(e)
+}
+
+/// How long [`ensure_run_id_free`] waits to join the router; one slower than that is left to the broker's own check.
+const CHECK_CONNECT_MS: u64 = 1000;
+
+/// Refuse run id `run` when its broker is live on the router at `connect` (`cosim_bus::claim`). A router that cannot
+/// be joined (within [`CHECK_CONNECT_MS`]) is not this check's to report: the broker, started next, says so.
+pub fn ensure_run_id_free(connect: &str, zenoh_config: Option<&Path>, run: &str) -> anyhow::Result<()> {
+    let connect = [connect.to_string()];
+    let session = match cosim_bus::session::open_client_from(zenoh_config, &connect, CHECK_CONNECT_MS) {
+        Ok(session) => session,
+        Err(e) => {
+            tracing::debug!("run id check skipped: {e:#}");
+            return Ok(());
+        }
+    };
+    let free = cosim_bus::claim::ensure_free(&session, run, cosim_proto::keys::topic::BROKER_ALIVE, "contact-broker");
+    drop(session);
+    free
+}
+
 /// Kills a child when dropped, so an early return never leaves a process behind.
 struct Guard {
     name: &'static str,
@@ -207,8 +236,13 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
             Ok(Event::Progress(_)) => {}
             Err(mpsc::RecvTimeoutError::Timeout) | Err(mpsc::RecvTimeoutError::Disconnected) => {}
         }
-        if broker.exited().is_some() {
-            anyhow::bail!("contact-broker failed to start: {}", last_line(&broker_log));
+        if let Some(status) = broker.exited() {
+            let said = last_line(&broker_log);
+            if status.code() == Some(2) {
+                let said = said.strip_prefix("contact-broker: ").unwrap_or(&said);
+                return Err(BrokerRefused(said.to_string()).into());
+            }
+            anyhow::bail!("contact-broker failed to start: {said}");
         }
         anyhow::ensure!(
             !interrupt.arrived(),
@@ -310,9 +344,11 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     drop(nodes);
 
     let summary_path = info.out.join("summary.json");
+    // The placeholder reserved at the start (`contact_broker::summary`) means the broker wrote none.
     match std::fs::read_to_string(&summary_path)
         .ok()
         .and_then(|s| serde_json::from_str::<Summary>(&s).ok())
+        .filter(|s| !s.is_placeholder())
     {
         Some(summary) => Ok(summary),
         None => {
@@ -335,7 +371,8 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
                     .collect();
                 format!("{how}; {}", nodes.join("; "))
             };
-            let mut summary = failed_summary(info, message, started.elapsed().as_secs_f64());
+            let mut summary = Summary::failed(&info.run_id, &info.mode, message);
+            summary.wall_seconds = started.elapsed().as_secs_f64();
             kept_outputs(&info.out, &mut summary);
             write_summary(&info.out, &summary)?;
             Ok(summary)
@@ -395,29 +432,4 @@ fn kept_outputs(out: &Path, summary: &mut Summary) {
         })
     };
     summary.frames = count("structure_").max(count("particles_"));
-}
-
-fn failed_summary(info: &RunInfo, message: String, wall: f64) -> Summary {
-    Summary {
-        status: "failed".into(),
-        message,
-        run_id: info.run_id.clone(),
-        scene: String::new(),
-        steps: 0,
-        fem_substeps: 0,
-        sph_substeps: 0,
-        sim_time: 0.0,
-        wall_seconds: wall,
-        particles: 0,
-        fem_nodes: 0,
-        fem_elements: 0,
-        solver: "none".into(),
-        contact: "none".into(),
-        mode: info.mode.clone(),
-        frames: 0,
-        samples: 0,
-        timings: Default::default(),
-        contact_stats: Default::default(),
-        counts: Default::default(),
-    }
 }

@@ -6,13 +6,19 @@ use clap::Parser;
 use cosim::cli::{Cli, Command};
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn,zenoh=error".into()),
-        )
-        .with_writer(std::io::stderr)
-        .init();
     let cli = Cli::parse();
+    // `cosim run` opens a zenoh session only to ask whether its run id is live (`run::run`); zenoh's own lines about
+    // a router it cannot join are the broker's to log, in its log file, and its one line says what went wrong.
+    let filter = match cli.command {
+        Command::Run(_) => "warn,zenoh=off",
+        _ => "warn,zenoh=error",
+    };
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| filter.into()))
+        .with_writer(std::io::stderr)
+        // A log line that cannot be written (stderr on a full disk) is lost rather than a panic.
+        .log_internal_errors(false)
+        .init();
     let result = match cli.command {
         Command::Run(args) => cosim::run::run(&args),
         Command::Check(args) => cosim::check::check(&args),

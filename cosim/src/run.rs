@@ -7,6 +7,7 @@ use anyhow::Context;
 use contact_broker::checkpoint::{self, Restart};
 use contact_broker::coordinator::{self, Checkpoints, Nodes, RunInfo};
 use contact_broker::link::{FemLink, SphLink};
+use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{self, LoadedScene};
@@ -100,12 +101,17 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             .and_then(|d| d.parent().map(Path::to_path_buf));
         parent.is_some() && parent == out.join("checkpoints").canonicalize().ok()
     });
-    prepare_out(&out, &scene, own_folder)?;
     let info = RunInfo {
         run_id,
         mode: if args.in_process { "in-process" } else { "processes" }.into(),
         out: out.clone(),
     };
+    // Through a router the run id may be live already (another `cosim run` on it): refused here, before the
+    // output folder (maybe that run's) is touched. The broker checks it again (`cosim_bus::claim`).
+    if let (Some(connect), false) = (&args.connect, args.in_process) {
+        launch::ensure_run_id_free(connect, args.zenoh_config.as_deref(), &info.run_id)?;
+    }
+    prepare_out(&out, &scene, &info, own_folder)?;
     let bar = Bar::new(args.quiet);
     let result = if args.in_process {
         run_in_process(args, &scene, &info, restart, &bar)
@@ -113,43 +119,50 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         launch::run_processes(args, &scene.scene, &info, &bar)
     };
     bar.finish();
-    match result {
-        Ok(summary) if summary.status == "ok" => {
-            println!(
-                "ok: {} steps to t = {} s in {:.2} s ({}) -> {}",
-                summary.steps,
-                summary.sim_time,
-                summary.wall_seconds,
-                summary.mode,
-                out.display()
-            );
-            Ok(ExitCode::SUCCESS)
-        }
-        Ok(summary) => {
-            eprintln!(
-                "cosim: run {}: {} (outputs so far in {})",
-                summary.status,
-                summary.message,
-                out.display()
-            );
-            Ok(ExitCode::from(1))
-        }
+    // Whatever ended the run before its summary, the summary says it (in place of the one reserved).
+    let summary = match result {
+        Ok(summary) => summary,
         Err(e) => {
-            eprintln!(
-                "cosim: {} (outputs so far in {})",
-                format!("{e:#}").replace('\n', " "),
-                out.display()
-            );
-            Ok(ExitCode::from(1))
+            let message = format!("{e:#}").replace('\n', " ");
+            let summary = Summary::failed(&info.run_id, &info.mode, message);
+            if let Err(w) = summary::write(&out, &summary) {
+                eprintln!("cosim: {w}");
+            }
+            // The broker refused the run id (`cosim_bus::claim`): refused input, exit code 2.
+            if launch::is_refused(&e) {
+                eprintln!("cosim: {} (summary in {})", summary.message, out.display());
+                return Ok(ExitCode::from(2));
+            }
+            eprintln!("cosim: {} (outputs so far in {})", summary.message, out.display());
+            return Ok(ExitCode::from(1));
         }
+    };
+    if summary.status == "ok" {
+        println!(
+            "ok: {} steps to t = {} s in {:.2} s ({}) -> {}",
+            summary.steps,
+            summary.sim_time,
+            summary.wall_seconds,
+            summary.mode,
+            out.display()
+        );
+        Ok(ExitCode::SUCCESS)
+    } else {
+        eprintln!(
+            "cosim: run {}: {} (outputs so far in {})",
+            summary.status,
+            summary.message,
+            out.display()
+        );
+        Ok(ExitCode::from(1))
     }
 }
 
-/// Create the folder, clear the outputs of an earlier run there, and keep the resolved scene beside them. A
-/// restart into the folder of the run it continues (`keep_frames`) keeps the frames: those before the checkpoint
-/// stay (and stay listed in the `.pvd` collections); the later ones are written again. The logs of the run that
-/// stopped, which explain why, move to `logs.before-restart`.
-fn prepare_out(out: &Path, scene: &LoadedScene, keep_frames: bool) -> anyhow::Result<()> {
+/// Create the folder, clear the outputs of an earlier run there, reserve `summary.json` (`contact_broker::summary`)
+/// and keep the resolved scene beside them. A restart into the folder of the run it continues (`keep_frames`) keeps
+/// the frames: those before the checkpoint stay (and stay listed in the `.pvd` collections); the later ones are
+/// written again. The logs of the run that stopped, which explain why, move to `logs.before-restart`.
+fn prepare_out(out: &Path, scene: &LoadedScene, info: &RunInfo, keep_frames: bool) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
     if keep_frames {
         let (logs, kept) = (out.join("logs"), out.join("logs.before-restart"));
@@ -172,6 +185,8 @@ fn prepare_out(out: &Path, scene: &LoadedScene, keep_frames: bool) -> anyhow::Re
     for stale in ["summary.json", "probes.csv"] {
         let _ = std::fs::remove_file(out.join(stale));
     }
+    // First, so that a disk that fills up later still has the room for it.
+    summary::reserve(out, &info.run_id, &info.mode)?;
     std::fs::write(out.join("scene.toml"), scene.scene.to_toml())
         .with_context(|| format!("cannot write {}", out.join("scene.toml").display()))?;
     Ok(())

@@ -51,6 +51,20 @@ pub enum CodecError {
         /// Run expected.
         expected: String,
     },
+    /// Too large to send: zenoh would drop it unseen ([`MAX_SEND_BYTES`]).
+    #[error(
+        "{what} message of {bytes} bytes ({:.2} GiB) is over the limit of {limit} bytes a message may have \
+         (docs/PROTOCOL.md §3): not sent",
+        *bytes as f64 / (1u64 << 30) as f64
+    )]
+    TooLarge {
+        /// The message's topic.
+        what: &'static str,
+        /// Its encoded size.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// Another step.
     #[error("{what} message is for step {got}, expected step {expected}")]
     Step {
@@ -65,6 +79,11 @@ pub enum CodecError {
 
 /// Largest message accepted by the decoder (guards against length prefixes that claim gigabytes).
 pub const MAX_MESSAGE_BYTES: u64 = 1 << 30;
+
+/// Largest message a sender puts on the wire ([`Envelope::encode_checked`]). zenoh drops a message over its
+/// `max_message_size` (1 GiB by default, on every peer and router on the way) with nothing logged above its trace
+/// level, so the receiver would only time out; its own header comes on top of ours, and this leaves it 64 KiB.
+pub const MAX_SEND_BYTES: u64 = MAX_MESSAGE_BYTES - (1 << 16);
 
 /// One fixed configuration, documented byte for byte in docs/PROTOCOL.md: little endian, fixed-width integers,
 /// u64 length prefixes.
@@ -100,6 +119,23 @@ impl<B: Serialize> Envelope<B> {
         encoder()
             .serialize(self)
             .expect("in-memory bincode encoding of plain data")
+    }
+
+    /// [`Envelope::encode`] for sending on topic `what`: refused ([`CodecError::TooLarge`], naming the topic and
+    /// the size) over [`MAX_SEND_BYTES`], which zenoh would drop without a word.
+    pub fn encode_checked(&self, what: &'static str) -> Result<Vec<u8>, CodecError> {
+        self.encode_within(what, MAX_SEND_BYTES)
+    }
+
+    /// [`Envelope::encode_checked`] with the limit `limit` bytes. The size is computed before anything is encoded.
+    pub fn encode_within(&self, what: &'static str, limit: u64) -> Result<Vec<u8>, CodecError> {
+        use bincode::Options;
+        // As in `encode`: sizing plain data has no failure path.
+        let bytes = encoder().serialized_size(self).expect("bincode sizing of plain data");
+        if bytes > limit {
+            return Err(CodecError::TooLarge { what, bytes, limit });
+        }
+        Ok(self.encode())
     }
 }
 

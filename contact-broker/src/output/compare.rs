@@ -77,7 +77,7 @@ pub fn plot_compare(path: &Path, title: &str, value: &str, curves: &[(String, Ve
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, e))?;
     }
-    std::fs::write(path, svg).map_err(|e| OutputError::io(path, e))
+    super::write_whole(path, svg.as_bytes())
 }
 
 #[cfg(test)]

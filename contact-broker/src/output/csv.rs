@@ -1,11 +1,12 @@
 //! `DIR/probes.csv`: header `t,<probe names…>`, one row per probe sample.
 //!
 //! Each row is written with one `write_all` on an unbuffered file as soon as it is pushed, so a run that dies
-//! keeps every sample taken. Numbers use Rust's shortest round-trip formatting of `f64` (`{}`, or `{:e}` below
+//! keeps every sample taken. A row that cannot be written whole (a full disk) is cut off again, so the file never
+//! ends in a torn row. Numbers use Rust's shortest round-trip formatting of `f64` (`{}`, or `{:e}` below
 //! 1e-4 and from 1e15): parsing a field back gives the same bits, and the same run gives the same bytes.
 
 use std::fs::File;
-use std::io::Write as _;
+use std::io::{Seek as _, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
 
 use super::{OutputError, Result};
@@ -15,6 +16,8 @@ use super::{OutputError, Result};
 pub struct ProbeCsv {
     path: PathBuf,
     file: File,
+    /// Bytes of whole rows (and the header) written.
+    len: u64,
     names: Vec<String>,
     rows: Vec<(f64, Vec<f64>)>,
 }
@@ -50,6 +53,7 @@ impl ProbeCsv {
         Ok(Self {
             path: path.to_path_buf(),
             file,
+            len: header.len() as u64,
             names: names.to_vec(),
             rows: Vec::new(),
         })
@@ -63,9 +67,14 @@ impl ProbeCsv {
                 format!("{} values for {} probes at t = {t}", values.len(), self.names.len()),
             ));
         }
-        self.file
-            .write_all(format_row(t, values).as_bytes())
-            .map_err(|e| OutputError::io(&self.path, e))?;
+        let row = format_row(t, values);
+        if let Err(e) = self.file.write_all(row.as_bytes()) {
+            // Back to the last whole row; the error is the one to report, whatever this does.
+            let _ = self.file.set_len(self.len);
+            let _ = self.file.seek(SeekFrom::Start(self.len));
+            return Err(OutputError::io(&self.path, e));
+        }
+        self.len += row.len() as u64;
         self.rows.push((t, values.to_vec()));
         Ok(())
     }

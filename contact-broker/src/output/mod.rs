@@ -29,12 +29,12 @@ pub use vtk::{von_mises_2d, FrameWriter, Part, PointField};
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// Reading or writing the file failed.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file or folder.
         path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
+        /// The OS error. In the message, not a `source`: an error chain printed whole (`{:#}`) says it once.
+        error: std::io::Error,
     },
     /// The VTK library could not encode a frame.
     #[error("{}: VTK: {message}", path.display())]
@@ -74,10 +74,10 @@ pub enum OutputError {
 pub type Result<T, E = OutputError> = std::result::Result<T, E>;
 
 impl OutputError {
-    pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
+    pub(crate) fn io(path: &Path, error: std::io::Error) -> Self {
         Self::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 
@@ -90,13 +90,36 @@ impl OutputError {
 }
 
 /// Write `bytes` to `path` through a temporary sibling and a rename, so that a reader (or a run that dies
-/// mid-write) sees either the old file or the new one, never a torn one.
+/// mid-write) sees either the old file or the new one, never a torn one. A write that fails (a full disk) removes
+/// the temporary file and names `path`.
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    with_temporary(path, |tmp| std::fs::write(tmp, bytes))
+}
+
+/// `path` with `.tmp` appended: where [`write_atomic`] and the frame writer put a file before renaming it.
+pub(crate) fn temporary(path: &Path) -> PathBuf {
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(|e| OutputError::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
+    PathBuf::from(tmp)
+}
+
+/// Write `path` by `write`-ing its [`temporary`] sibling, then renaming it. When either fails, the temporary file
+/// is removed (a full disk leaves no stray `.tmp` behind) and the error names `path`.
+pub(crate) fn with_temporary(path: &Path, write: impl FnOnce(&Path) -> std::io::Result<()>) -> Result<()> {
+    let tmp = temporary(path);
+    write(&tmp).and_then(|()| std::fs::rename(&tmp, path)).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        OutputError::io(path, e)
+    })
+}
+
+/// Write `bytes` to `path` in one go (a plot: nothing reads it during the run); a write that fails (a full disk)
+/// removes the torn file and names `path`.
+pub(crate) fn write_whole(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).map_err(|e| {
+        let _ = std::fs::remove_file(path);
+        OutputError::io(path, e)
+    })
 }
 
 /// A fresh, empty folder under the system temp dir for one test.

@@ -59,7 +59,7 @@ pub fn plot_probe(
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, e))?;
     }
-    std::fs::write(path, svg).map_err(|e| OutputError::io(path, e))?;
+    super::write_whole(path, svg.as_bytes())?;
     reference_error.map_or(Ok(()), Err)
 }
 

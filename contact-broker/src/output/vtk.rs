@@ -13,7 +13,7 @@ use vtkio::model::{
 };
 
 use super::pvd::PvdCollection;
-use super::{write_atomic, OutputError, Result};
+use super::{with_temporary, write_atomic, OutputError, Result};
 
 /// In-plane von Mises stress `sqrt(σxx² − σxx σyy + σyy² + 3 σxy²)` of `[σxx, σyy, σxy]`.
 ///
@@ -232,16 +232,11 @@ fn write_streamed(
     path: &Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let file = std::fs::File::create(&tmp).map_err(|e| OutputError::io(&tmp, e))?;
-    let mut out = std::io::BufWriter::with_capacity(64 * 1024, file);
-    write(&mut out)
-        .and_then(|()| out.flush())
-        .map_err(|e| OutputError::io(&tmp, e))?;
-    drop(out);
-    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
+    with_temporary(path, |tmp| {
+        let mut out = std::io::BufWriter::with_capacity(64 * 1024, std::fs::File::create(tmp)?);
+        write(&mut out)?;
+        out.flush()
+    })
 }
 
 /// Write the frame to a temporary file, streaming (the text of a frame is never held whole), then rename it.
