@@ -682,12 +682,9 @@ impl WcsphSolver {
     fn density_half_kick(&mut self, dt: f64) {
         let nf = self.state.len();
         let mut drho = std::mem::take(&mut self.scratch.per1);
-        if let Some(d) = self.density_diffusion() {
-            let (view, vol, list) = (self.view(), &self.sorted.vol, &self.scratch.list);
-            continuity::density_rates_pairs_diffusive_into(&view, vol, list, &d, &mut drho);
-        } else {
-            continuity::density_rates_pairs_into(&self.view(), &self.sorted.vol, &self.scratch.list, &mut drho);
-        }
+        let diffusion = self.density_diffusion();
+        let (view, vol, list) = (self.view(), &self.sorted.vol, &self.scratch.list);
+        continuity::density_rates_pairs_into(&view, vol, list, diffusion.as_ref(), &mut drho);
         let s = &mut self.sorted;
         integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
@@ -929,7 +926,7 @@ mod tests {
             assert_eq!(list.of(i), reference.of(i), "neighbours of slot {i}");
         }
         let mut drho = Vec::new();
-        continuity::density_rates_pairs_into(&view, &solver.sorted.vol, list, &mut drho);
+        continuity::density_rates_pairs_into(&view, &solver.sorted.vol, list, None, &mut drho);
         for (i, d) in drho.iter().enumerate() {
             assert_eq!(d.to_bits(), density_rate(i, &view, reference.of(i), &kernel).to_bits());
         }

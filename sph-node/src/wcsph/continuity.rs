@@ -34,37 +34,16 @@ pub fn density_rates_into(view: &ParticleView<'_>, list: &NeighborList, kernel: 
 
 /// [`density_rate`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair
 /// (i, `neighbors[k]`), see [`crate::neighbors::ListChunk`]) and `vol[j]` = m_j/ρ_j: the same sum, bit for bit.
+/// With `diffusion`, the δ-SPH diffusive term D_i of the fluid–fluid pairs ([`DensityDiffusion`]) is added, summed
+/// in the same pass over the neighbours.
 #[inline]
-pub fn density_rate_pairs(i: usize, view: &ParticleView<'_>, vol: &[f64], neighbors: &[u32], grad: &[f64]) -> f64 {
-    let (xi, vi) = (view.x[i], view.v[i]);
-    let mut sum = 0.0;
-    for (&j, &f) in neighbors.iter().zip(grad) {
-        let j = j as usize;
-        let (xj, vj) = (view.x[j], view.v[j]);
-        let grad = [f * (xi[0] - xj[0]), f * (xi[1] - xj[1])];
-        let v_ij = [vi[0] - vj[0], vi[1] - vj[1]];
-        // Eq. (9), Long et al. 2016
-        sum += vol[j] * dot(v_ij, grad);
-    }
-    view.rho[i] * sum // Eq. (9), Long et al. 2016
-}
-
-/// Dρ/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
-/// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j.
-pub fn density_rates_pairs_into(view: &ParticleView<'_>, vol: &[f64], list: &NeighborList, out: &mut Vec<f64>) {
-    list.map_pairs_into(out, |i, idx, grad| density_rate_pairs(i, view, vol, idx, grad));
-}
-
-/// [`density_rate_pairs`] plus the δ-SPH diffusive term D_i of fluid–fluid pairs ([`DensityDiffusion`]), in the
-/// same pass over the neighbours (the continuity part is summed exactly as in [`density_rate_pairs`]).
-#[inline]
-pub fn density_rate_pairs_diffusive(
+pub fn density_rate_pairs(
     i: usize,
     view: &ParticleView<'_>,
     vol: &[f64],
     neighbors: &[u32],
     grad: &[f64],
-    diffusion: &DensityDiffusion,
+    diffusion: Option<&DensityDiffusion>,
 ) -> f64 {
     let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
     let mut sum = 0.0;
@@ -76,23 +55,28 @@ pub fn density_rate_pairs_diffusive(
         let v_ij = [vi[0] - vj[0], vi[1] - vj[1]];
         // Eq. (9), Long et al. 2016
         sum += vol[j] * dot(v_ij, grad);
-        if j < view.n_fluid {
+        if let Some(d) = diffusion.filter(|_| j < view.n_fluid) {
             // Molteni & Colagrossi 2009 with Fourtakas et al. 2019 (density_diffusion.rs)
-            diff += diffusion.pair(xi, xj, rho_i, view.rho[j], f, vol[j]);
+            diff += d.pair(xi, xj, rho_i, view.rho[j], f, vol[j]);
         }
     }
-    rho_i * sum - diffusion.coef * diff // Eq. (9), Long et al. 2016, + D_i
+    match diffusion {
+        Some(d) => rho_i * sum - d.coef * diff, // Eq. (9), Long et al. 2016, + D_i
+        None => rho_i * sum,                    // Eq. (9), Long et al. 2016
+    }
 }
 
-/// [`density_rates_pairs_into`] with the δ-SPH term ([`density_rate_pairs_diffusive`]).
-pub fn density_rates_pairs_diffusive_into(
+/// Dρ/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
+/// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j; with the δ-SPH term when `diffusion`
+/// is given.
+pub fn density_rates_pairs_into(
     view: &ParticleView<'_>,
     vol: &[f64],
     list: &NeighborList,
-    diffusion: &DensityDiffusion,
+    diffusion: Option<&DensityDiffusion>,
     out: &mut Vec<f64>,
 ) {
     list.map_pairs_into(out, |i, idx, grad| {
-        density_rate_pairs_diffusive(i, view, vol, idx, grad, diffusion)
+        density_rate_pairs(i, view, vol, idx, grad, diffusion)
     });
 }
