@@ -13,33 +13,11 @@ use common::*;
 
 const LIMIT: Duration = Duration::from_secs(30);
 
-/// A valid structure-only scene; each case edits one thing.
-const PLATE: &str = r#"
-version = 1
-[run]
-name = "limits"
-end_time = 0.01
-output_interval = 0.005
-[[solid]]
-name = "beam"
-min = [0.0, 0.0]
-max = [0.1, 0.01]
-divisions = [10, 2]
-material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1.0e6, poisson_ratio = 0.3 }
-fixed = [{ min = [-0.001, -0.001], max = [0.001, 0.011] }]
-[[probe]]
-name = "tip"
-kind = "node_displacement"
-solid = "beam"
-point = [0.1, 0.005]
-component = "y"
-"#;
+const PLATE: &str = BEAM_SCENE;
 
+/// `write_scene` with this file's folder prefix.
 fn write_scene(name: &str, text: &str) -> PathBuf {
-    let dir = scratch(&format!("limits-{name}"));
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, text).unwrap();
-    path
+    common::write_scene("limits", name, text)
 }
 
 /// `cosim check|run SCENE --set …` in the workspace root (so `scenes/…` resolves), bounded by `limit`; a `sets` item

@@ -192,3 +192,33 @@ pub fn alive(pid: u32) -> bool {
         .map(|s| s.rsplit_once(") ").is_some_and(|(_, rest)| !rest.starts_with('Z')))
         .unwrap_or(false)
 }
+
+/// A valid structure-only scene (a clamped beam with a tip probe); tests of bad input edit one thing of it.
+pub const BEAM_SCENE: &str = r#"
+version = 1
+[run]
+name = "bad"
+end_time = 0.01
+output_interval = 0.005
+[[solid]]
+name = "beam"
+min = [0.0, 0.0]
+max = [0.1, 0.01]
+divisions = [10, 2]
+material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1.0e6, poisson_ratio = 0.3 }
+fixed = [{ min = [-0.001, -0.001], max = [0.001, 0.011] }]
+[[probe]]
+name = "tip"
+kind = "node_displacement"
+solid = "beam"
+point = [0.1, 0.005]
+component = "y"
+"#;
+
+/// Write `text` as `<name>.toml` in a fresh folder `<prefix>-<name>`; its path.
+pub fn write_scene(prefix: &str, name: &str, text: &str) -> PathBuf {
+    let dir = scratch(&format!("{prefix}-{name}"));
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
