@@ -17,7 +17,7 @@ use crate::interface::{Corrections, Interface, PassStats};
 use crate::link::{FemLink, LinkError, Reply, SphLink};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::Probes;
-use crate::summary::{ContactStats, Summary, Timings};
+use crate::summary::{ContactStats, Summary};
 
 /// Progress of a run, reported after each coupling step.
 #[derive(Clone, Copy, Debug, Default)]
@@ -103,16 +103,11 @@ pub fn run_with(
         .fem
         .as_ref()
         .map_or((0, 0), |f| (f.setup().nodes.len() as u64, f.setup().cells.len() as u64));
+    // Every counter starts at zero, as in the summary of a run that failed before it computed anything.
     let mut summary = Summary {
         status: "ok".into(),
         message: String::new(),
-        run_id: info.run_id.clone(),
         scene: s.run.name.clone(),
-        steps: 0,
-        fem_substeps: 0,
-        sph_substeps: 0,
-        sim_time: 0.0,
-        wall_seconds: 0.0,
         particles: nodes.sph.as_ref().map_or(0, |n| u64::from(n.setup().particles)),
         fem_nodes,
         fem_elements,
@@ -125,12 +120,7 @@ pub fn run_with(
         } else {
             "none".into()
         },
-        mode: info.mode.clone(),
-        frames: 0,
-        samples: 0,
-        timings: Timings::default(),
-        contact_stats: ContactStats::default(),
-        counts: Default::default(),
+        ..Summary::failed(&info.run_id, &info.mode, String::new())
     };
     let mut series = Vec::new();
     let error = drive(scene, &mut nodes, info, plan, progress, &mut summary, &mut series).err();
