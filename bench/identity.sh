@@ -9,7 +9,7 @@
 #
 # Checkpoint files are listed apart (`ckpt` lines): a checkpoint format change alters their bytes by design; what
 # must hold then is that the restart from them gives the same probes and frames (`restart` cases).
-# COSIM (default target/release/cosim) picks the build.
+# Each case has a fixed run id (checkpoints hold it). COSIM (default target/release/cosim) picks the build.
 set -euo pipefail
 out=${1:?usage: bench/identity.sh OUT_DIR}
 cosim=${COSIM:-target/release/cosim}
@@ -17,7 +17,7 @@ rm -rf "$out"; mkdir -p "$out"
 
 run() { # case scene mode [--set ...]
   local name=$1 scene=$2 mode=$3; shift 3
-  local flags=(-q --out "$out/$name")
+  local flags=(-q --out "$out/$name" --run-id "identity-$name")
   [[ $mode == in ]] && flags+=(--in-process)
   "$cosim" run "scenes/$scene.toml" "${flags[@]}" "$@" >"$out/$name.log" 2>&1 || {
     echo "identity: case $name failed, see $out/$name.log" >&2; tail -3 "$out/$name.log" >&2; exit 1; }
@@ -62,6 +62,10 @@ find . -type f ! -name '*.log' | sort | while read -r f; do
       h=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1]))
 for k in ("wall_seconds","timings","run_id","mode"): s.pop(k,None)
 print(json.dumps(s,sort_keys=True))' "$f" | sha256sum | cut -c1-16); echo "$h  $f";;
+    */checkpoint.json)
+      h=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); s.pop("write_seconds",None); s["files"]["broker.bin"].pop("crc32",None)
+print(json.dumps(s,sort_keys=True))' "$f" | sha256sum | cut -c1-16); echo "ckpt $h  $f";;
+    */broker.bin) echo "ckpt bytes=$(stat -c %s "$f")  $f";;  # holds the run's wall-clock timings
     */checkpoints/*) echo "ckpt $(sha256sum "$f" | cut -c1-16)  $f";;
     */external.json) ;;
     *) echo "$(sha256sum "$f" | cut -c1-16)  $f";;
