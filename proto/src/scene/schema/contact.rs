@@ -32,7 +32,7 @@ pub struct ContactSpec {
     /// Algorithm.
     #[serde(default = "default_algorithm")]
     pub algorithm: ContactAlgorithm,
-    /// Contact thickness r_c [m]; default spacing / 2.
+    /// Contact thickness r_c \[m\]; default spacing / 2.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<f64>,
     /// Gauss–Seidel sweeps.

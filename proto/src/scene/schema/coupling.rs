@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CouplingSpec {
-    /// Cap on the coupling step [s].
+    /// Cap on the coupling step \[s\].
     #[serde(default = "default_max_dt")]
     pub max_dt: f64,
     /// Safety factor on the FEM stable step, Δt_fem = fem_cfl · min_e(L_e / c_d).

@@ -48,7 +48,7 @@ pub struct FluidSpec {
     /// Kinematic viscosity ν [m²/s]; 0 disables the viscous term.
     #[serde(default)]
     pub kinematic_viscosity: f64,
-    /// Particle spacing Δx [m].
+    /// Particle spacing Δx \[m\].
     pub spacing: f64,
     /// h = smoothing_ratio · spacing.
     #[serde(default = "default_smoothing_ratio")]

@@ -52,12 +52,12 @@ pub struct Scene {
 pub struct RunSpec {
     /// Name used in outputs.
     pub name: String,
-    /// Simulated end time [s].
+    /// Simulated end time \[s\].
     pub end_time: f64,
     /// Gravity [m/s²].
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 2],
-    /// Interval between frames and probe samples [s].
+    /// Interval between frames and probe samples \[s\].
     pub output_interval: f64,
 }
 

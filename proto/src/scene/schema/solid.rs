@@ -34,7 +34,7 @@ pub struct MaterialSpec {
     pub model: MaterialModel,
     /// Density [kg/m³].
     pub density: f64,
-    /// Young's modulus [Pa].
+    /// Young's modulus \[Pa\].
     pub youngs_modulus: f64,
     /// Poisson's ratio, in [0, 0.5).
     pub poisson_ratio: f64,
