@@ -29,16 +29,6 @@ const GATE: [&str; 6] = [
     "0.05",
 ];
 
-fn run_ok(args: &[&str]) {
-    let out = cosim_run(args, LIMIT);
-    assert!(
-        out.status.success(),
-        "cosim {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 /// The checkpoint folders of a run, by step.
 fn checkpoints(out: &Path) -> Vec<(u64, PathBuf)> {
     let mut found: Vec<(u64, PathBuf)> = std::fs::read_dir(out.join("checkpoints"))

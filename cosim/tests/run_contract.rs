@@ -24,19 +24,6 @@ fn csm3_args<'a>(out: &'a str, run: &'a str, end: &'a str) -> Vec<&'a str> {
     ]
 }
 
-fn run_ok(args: &[&str]) -> std::process::Output {
-    let mut cmd = std::process::Command::new(cosim());
-    cmd.current_dir(root()).args(args).env("COSIM_BIN_DIR", bin_dir());
-    let out = run_bounded(&mut cmd, LIMIT);
-    assert!(
-        out.status.success(),
-        "cosim {args:?} failed: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 #[test]
 fn processes_run_writes_every_output_of_the_contract() {
     let dir = scratch("contract");

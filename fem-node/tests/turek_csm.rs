@@ -5,7 +5,7 @@
 //! (The true bar meets the cylinder along an arc from x = 0.24899 at its faces to 0.25 on its axis; clamping at
 //! 0.24899 makes the bar 0.3% longer and the coarse mesh ~2.5% more flexible than the reference.)
 //! Mesh: 70 × 4 quad4 (5 mm squares), the mesh of `scenes/csm3.toml`.
-//! Reference: `data/csm3_point_A_featflow_l4_dt0.005.csv` and `data/turek_hron_reference_values.csv`.
+//! Reference: `scenes/data/csm3_point_A_featflow_l4_dt0.005.csv` and `data/turek_hron_reference_values.csv`.
 
 mod common;
 
@@ -47,7 +47,10 @@ fn run(damping: f64, t_end: f64, sample: f64) -> (Series, Series) {
 
 /// The featflow series: `(t, ux, uy)`.
 fn reference_series() -> Vec<[f64; 3]> {
-    let text = include_str!("data/csm3_point_A_featflow_l4_dt0.005.csv");
+    let text = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/data/csm3_point_A_featflow_l4_dt0.005.csv"
+    ));
     text.lines()
         .skip(1)
         .map(|l| {

@@ -6,10 +6,10 @@ pub mod envelope;
 pub mod keys;
 pub mod messages;
 pub mod overlap;
-mod overrides;
 pub mod scene;
 pub mod session;
-pub mod sizing;
 pub mod validate;
+
+pub use scene::sizing;
 
 pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

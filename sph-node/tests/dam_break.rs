@@ -1,5 +1,5 @@
 //! Dam break, column a × 2a (Martin & Moyce 1952, n² = 2), WCSPH and ISPH: surge front Z = z/a against
-//! T = t sqrt(2g/a) (files and sources in tests/data/SOURCE.txt).
+//! T = t sqrt(2g/a) (files in scenes/data/ and tests/data/, sources in scenes/data/README.md and tests/data/SOURCE.txt).
 //!
 //! Two references, two checks:
 //! * Koshizuka & Oka's (1996) MPS computation of the same case: an independent particle method with an
@@ -35,8 +35,14 @@ fn curve(text: &str) -> Vec<(f64, f64)> {
 /// The Martin & Moyce n² = 2 points with 0 < T ≤ 2.5, from the three digitisations.
 fn experiment() -> Vec<(f64, f64)> {
     [
-        include_str!("data/mm1952_n2eq2_a2.25in_pysph.csv"),
-        include_str!("data/mm1952_n2eq2_a1.125in_pysph.csv"),
+        include_str!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenes/data/mm1952_n2eq2_a2.25in_pysph.csv"
+        )),
+        include_str!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenes/data/mm1952_n2eq2_a1.125in_pysph.csv"
+        )),
         include_str!("data/mm1952_n2eq2_lethe.csv"),
     ]
     .into_iter()
@@ -46,7 +52,10 @@ fn experiment() -> Vec<(f64, f64)> {
 }
 
 fn mps() -> Vec<(f64, f64)> {
-    curve(include_str!("data/koshizuka_oka1996_MPS_front_pysph.csv"))
+    curve(include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/data/koshizuka_oka1996_MPS_front_pysph.csv"
+    )))
 }
 
 /// Linear interpolation of y(x) on a curve sorted by x.

@@ -74,6 +74,25 @@ pub fn cosim_run(args: &[&str], limit: Duration) -> Output {
     run_bounded(Command::new(cosim()).args(args).env("COSIM_BIN_DIR", bin_dir()), limit)
 }
 
+/// Bound on one `cosim` command of [`run_ok`].
+pub const RUN_LIMIT: Duration = Duration::from_secs(240);
+
+/// `cosim ARGS` from the workspace root (so scene paths may be relative to it), bounded by [`RUN_LIMIT`]; fails the
+/// test, with the command and its output, unless it succeeds.
+pub fn run_ok(args: &[&str]) -> Output {
+    let mut cmd = Command::new(cosim());
+    cmd.current_dir(root()).args(args).env("COSIM_BIN_DIR", bin_dir());
+    let out = run_bounded(&mut cmd, RUN_LIMIT);
+    assert!(
+        out.status.success(),
+        "cosim {} failed: {}{}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// A unique run id per test.
 pub fn run_id(name: &str) -> String {
     format!("t{}-{}", std::process::id(), name)

@@ -116,3 +116,48 @@ impl Element {
 fn gather<const N: usize>(x: &[[f64; 2]], nodes: &[u32; N]) -> [[f64; 2]; N] {
     nodes.map(|n| x[n as usize])
 }
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    /// The tests every element passes, written once and expanded in each element's `tests` module (as fenris
+    /// applies its test macros to every element), under every material law:
+    /// `element_tests!(element = |lame| Quad4::new(..), deformed = [..], lame = Lame::from_young_poisson(..))`.
+    ///
+    /// - `forces_are_the_energy_gradient`: the internal nodal forces at the deformed positions are `∂E/∂x` of the
+    ///   element's strain energy, by central differences (h = 1e-7, error below 1e-5 · 1e6), for each of the
+    ///   linear elastic, neo-Hookean and St. Venant–Kirchhoff laws with the given Lamé parameters.
+    macro_rules! element_tests {
+        (element = $element:expr, deformed = $x:expr, lame = $lame:expr) => {
+            #[test]
+            fn forces_are_the_energy_gradient() {
+                use $crate::material::{CorotationalLinearElastic, Material, NeoHookean, StVenantKirchhoff};
+                let lame = $lame;
+                let element = ($element)(lame);
+                let x = $x;
+                for law in [
+                    Material::LinearElastic(CorotationalLinearElastic { lame }),
+                    Material::NeoHookean(NeoHookean { lame }),
+                    Material::StVenantKirchhoff(StVenantKirchhoff { lame }),
+                ] {
+                    let mut f = [[0.0; 2]; 4];
+                    element.internal_forces(&x, &law, &mut f).unwrap();
+                    let h = 1e-7;
+                    for i in 0..x.len() {
+                        for k in 0..2 {
+                            let (mut xp, mut xm) = (x, x);
+                            xp[i][k] += h;
+                            xm[i][k] -= h;
+                            let d = (element.strain_energy(&xp, &law) - element.strain_energy(&xm, &law)) / (2.0 * h);
+                            assert!(
+                                (d - f[i][k]).abs() < 1e-5 * 1e6,
+                                "{law:?} node {i} comp {k}: {d} vs {}",
+                                f[i][k]
+                            );
+                        }
+                    }
+                }
+            }
+        };
+    }
+    pub(crate) use element_tests;
+}

@@ -206,6 +206,7 @@ fn signed_area(p: &[Vector2<f64>; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::element::test_support::element_tests;
     use crate::material::{Hyperelastic, Lame, StVenantKirchhoff};
 
     fn lame() -> Lame {
@@ -225,28 +226,11 @@ mod tests {
         assert_eq!(Quad4::lumped_masses(&rect(2.0, 2.0), 3.0), [3.0; 4]);
     }
 
-    #[test]
-    fn forces_are_the_energy_gradient() {
-        let law = StVenantKirchhoff { lame: lame() };
-        let q = Quad4::new([0, 1, 2, 3], [[0.1, 0.0], [1.3, 0.1], [1.2, 0.8], [0.0, 0.7]], lame()).unwrap();
-        let x = [[0.15, -0.05], [1.25, 0.3], [1.0, 1.0], [-0.15, 0.65]];
-        let mut f = [[0.0; 2]; 4];
-        q.internal_forces(&x, &law, &mut f).unwrap();
-        let h = 1e-7;
-        for i in 0..4 {
-            for k in 0..2 {
-                let (mut xp, mut xm) = (x, x);
-                xp[i][k] += h;
-                xm[i][k] -= h;
-                let d = (q.strain_energy(&xp, &law) - q.strain_energy(&xm, &law)) / (2.0 * h);
-                assert!(
-                    (d - f[i][k]).abs() < 1e-5 * 1e6,
-                    "node {i} comp {k}: {d} vs {}",
-                    f[i][k]
-                );
-            }
-        }
-    }
+    element_tests!(
+        element = |lame| Quad4::new([0, 1, 2, 3], [[0.1, 0.0], [1.3, 0.1], [1.2, 0.8], [0.0, 0.7]], lame).unwrap(),
+        deformed = [[0.15, -0.05], [1.25, 0.3], [1.0, 1.0], [-0.15, 0.65]],
+        lame = lame()
+    );
 
     #[test]
     fn pure_bending_energy_is_exact() {

@@ -90,7 +90,8 @@ impl Tri3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{Lame, NeoHookean};
+    use crate::element::test_support::element_tests;
+    use crate::material::Lame;
 
     #[test]
     fn gradients_of_the_unit_triangle() {
@@ -102,28 +103,9 @@ mod tests {
         assert!(Tri3::new([0, 2, 1], [[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]).is_err());
     }
 
-    #[test]
-    fn forces_are_the_energy_gradient() {
-        let law = NeoHookean {
-            lame: Lame::from_young_poisson(1.0e6, 0.45),
-        };
-        let t = Tri3::new([0, 1, 2], [[0.0, 0.0], [1.0, 0.2], [0.3, 0.9]]).unwrap();
-        let x = [[0.1, -0.1], [1.2, 0.4], [0.0, 1.0]];
-        let mut f = [[0.0; 2]; 4];
-        t.internal_forces(&x, &law, &mut f).unwrap();
-        let h = 1e-7;
-        for i in 0..3 {
-            for k in 0..2 {
-                let (mut xp, mut xm) = (x, x);
-                xp[i][k] += h;
-                xm[i][k] -= h;
-                let d = (t.strain_energy(&xp, &law) - t.strain_energy(&xm, &law)) / (2.0 * h);
-                assert!(
-                    (d - f[i][k]).abs() < 1e-5 * 1e6,
-                    "node {i} comp {k}: {d} vs {}",
-                    f[i][k]
-                );
-            }
-        }
-    }
+    element_tests!(
+        element = |_| Tri3::new([0, 1, 2], [[0.0, 0.0], [1.0, 0.2], [0.3, 0.9]]).unwrap(),
+        deformed = [[0.1, -0.1], [1.2, 0.4], [0.0, 1.0]],
+        lame = Lame::from_young_poisson(1.0e6, 0.45)
+    );
 }

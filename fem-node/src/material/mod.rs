@@ -145,6 +145,62 @@ pub(crate) mod test_support {
         Lame::from_young_poisson(1.4e6, 0.4)
     }
 
+    /// The tests every hyperelastic law passes, written once and expanded in each law's `tests` module (as fenris
+    /// applies its test macros to every material): `hyperelastic_law_tests!(law(), rigid_energy_tolerance = 1e-9)`.
+    /// `law()` makes the law (with a `lame` field); the tolerance bounds `W` of a rigid rotation relative to μ,
+    /// which is exactly zero in exact arithmetic for every law but carries each formula's own round-off.
+    ///
+    /// - `zero_stress_for_identity_and_rigid_rotation`: `P(I) = 0` exactly, `P(R) ≈ 0` and `W(R) ≈ 0`;
+    /// - `matches_hooke_for_small_strain`: `σ` of `F = I + ∇u`, |∇u| ~ 1e-6, is Hooke's within 1e-5;
+    /// - `piola_is_the_energy_gradient`: `P = ∂W/∂F` by central differences at stretched and rotated `F`.
+    macro_rules! hyperelastic_law_tests {
+        ($law:expr, rigid_energy_tolerance = $tolerance:expr) => {
+            #[test]
+            fn zero_stress_for_identity_and_rigid_rotation() {
+                use nalgebra::Matrix2;
+                use $crate::material::test_support::rotation;
+                use $crate::material::Hyperelastic;
+                let m = $law;
+                assert_eq!(m.first_piola(&Matrix2::identity()), Matrix2::zeros());
+                for angle in [0.3, 1.7, -2.9, std::f64::consts::PI * 0.999] {
+                    let p = m.first_piola(&rotation(angle));
+                    assert!(p.abs().max() < 1e-9 * m.lame.mu, "angle {angle}: {p}");
+                    assert!(m.energy_density(&rotation(angle)).abs() < $tolerance * m.lame.mu);
+                }
+            }
+
+            #[test]
+            fn matches_hooke_for_small_strain() {
+                use nalgebra::Matrix2;
+                use $crate::material::Hyperelastic;
+                let m = $law;
+                let grad = Matrix2::new(0.3, -0.7, 0.4, 0.9) * 1e-6;
+                let sigma = m.cauchy(&(Matrix2::identity() + grad));
+                let eps = 0.5 * (grad + grad.transpose());
+                let hooke = Matrix2::identity() * (m.lame.lambda * eps.trace()) + eps * (2.0 * m.lame.mu);
+                assert!(
+                    (sigma - hooke).abs().max() < 1e-5 * hooke.abs().max(),
+                    "{sigma} vs {hooke}"
+                );
+            }
+
+            #[test]
+            fn piola_is_the_energy_gradient() {
+                use nalgebra::Matrix2;
+                use $crate::material::test_support::{piola_matches_energy_gradient, rotation};
+                let m = $law;
+                for f in [
+                    rotation(0.6) * Matrix2::new(1.1, 0.05, 0.05, 0.93),
+                    rotation(-0.4) * Matrix2::new(1.2, 0.1, 0.1, 0.85),
+                    rotation(2.0) * Matrix2::new(1.05, -0.1, -0.1, 0.9),
+                ] {
+                    assert!(piola_matches_energy_gradient(&m, f, m.lame.mu) < 1e-6, "F = {f}");
+                }
+            }
+        };
+    }
+    pub(crate) use hyperelastic_law_tests;
+
     #[test]
     fn lame_of_turek_bar() {
         let l = turek();

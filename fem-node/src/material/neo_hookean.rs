@@ -39,34 +39,5 @@ mod tests {
         NeoHookean { lame: turek() }
     }
 
-    #[test]
-    fn zero_stress_for_identity_and_rigid_rotation() {
-        let m = law();
-        assert_eq!(m.first_piola(&Matrix2::identity()), Matrix2::zeros());
-        for angle in [0.3, 1.7, -2.9] {
-            let p = m.first_piola(&rotation(angle));
-            assert!(p.abs().max() < 1e-9 * m.lame.mu, "angle {angle}: {p}");
-            assert!(m.energy_density(&rotation(angle)).abs() < 1e-9 * m.lame.mu);
-        }
-    }
-
-    #[test]
-    fn matches_hooke_for_small_strain() {
-        let m = law();
-        let grad = Matrix2::new(0.3, -0.7, 0.4, 0.9) * 1e-6;
-        let sigma = m.cauchy(&(Matrix2::identity() + grad));
-        let eps = 0.5 * (grad + grad.transpose());
-        let hooke = Matrix2::identity() * (m.lame.lambda * eps.trace()) + eps * (2.0 * m.lame.mu);
-        assert!(
-            (sigma - hooke).abs().max() < 1e-5 * hooke.abs().max(),
-            "{sigma} vs {hooke}"
-        );
-    }
-
-    #[test]
-    fn piola_is_the_energy_gradient() {
-        let m = law();
-        let f = rotation(-0.4) * Matrix2::new(1.2, 0.1, 0.1, 0.85);
-        assert!(piola_matches_energy_gradient(&m, f, m.lame.mu) < 1e-6);
-    }
+    hyperelastic_law_tests!(law(), rigid_energy_tolerance = 1e-9);
 }

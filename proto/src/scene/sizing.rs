@@ -11,7 +11,7 @@
 //! 10⁶ FE elements, less the fixed part (docs/PERFORMANCE.md, "Memory per particle" and "Scene sizing"). They are
 //! good to some tens of per cent: enough to tell a run that fits from one that cannot.
 
-use crate::scene::{BoxSpec, ElementKind, FluidSolver, Scene, SolidSpec};
+use super::schema::{BoxSpec, ElementKind, FluidSolver, Scene, SolidSpec};
 
 /// Most particles (fluid and walls together), FE nodes, FE elements or neighbour-grid cells a run may have: their
 /// ids are `u32` on the wire (`docs/PROTOCOL.md`) and in the solvers' lists.

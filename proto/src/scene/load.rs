@@ -1,0 +1,120 @@
+//! Reading a scene: TOML text, `--set` overrides applied to it, serde with the full dotted key of any error, then
+//! [`Scene::validate`]. Every user error is a [`SceneError`].
+
+use std::path::{Path, PathBuf};
+
+use super::overrides;
+use super::schema::Scene;
+
+/// A user error in a scene: one line naming the file, the key and the problem.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}: {key}: {message}")]
+pub struct SceneError {
+    /// Scene file (or `--set` for an override).
+    pub file: String,
+    /// Dotted key path, e.g. `solid[0].material.youngs_modulus`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl SceneError {
+    fn new(file: &str, key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            file: file.to_string(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// A scene with where it came from.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The validated scene.
+    pub scene: Scene,
+    /// The file it was read from.
+    pub path: PathBuf,
+}
+
+impl LoadedScene {
+    /// Resolve a path written in the scene (relative to the scene file's folder).
+    pub fn resolve(&self, relative: &str) -> PathBuf {
+        let p = Path::new(relative);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.path.parent().unwrap_or(Path::new(".")).join(p)
+        }
+    }
+}
+
+/// Read, override and validate a scene file. `overrides` are `key.path=value` strings (`--set`).
+pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError> {
+    let file = path.display().to_string();
+    let text =
+        std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", format!("cannot read: {e}")))?;
+    let scene = parse(&file, &text, overrides)?;
+    Ok(LoadedScene {
+        scene,
+        path: path.to_path_buf(),
+    })
+}
+
+/// Parse, override and validate scene text; `file` names it in errors.
+pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+    let mut value: toml::Value = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+    for o in overrides {
+        overrides::apply(&mut value, o).map_err(|(key, msg)| SceneError::new(file, format!("--set {key}"), msg))?;
+    }
+    let scene: Scene = serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner().to_string();
+        let (key, message) = key_of_serde_error(&path, &inner);
+        SceneError::new(file, key, message)
+    })?;
+    scene.validate().map_err(|(key, msg)| SceneError::new(file, key, msg))?;
+    Ok(scene)
+}
+
+/// One line for a TOML syntax error: the line number and toml's own message.
+fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> SceneError {
+    let key = match e.span() {
+        Some(span) => format!("line {}", text[..span.start.min(text.len())].matches('\n').count() + 1),
+        None => "(syntax)".to_string(),
+    };
+    SceneError::new(file, key, e.message().replace('\n', " "))
+}
+
+/// Make the key of a serde error the full dotted path of the offending field.
+fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
+    let parent = if path == "." { String::new() } else { path.to_string() };
+    // serde_path_to_error already ends the path with an unknown field, but not with a missing one.
+    let join = |field: &str| {
+        if parent.is_empty() {
+            field.to_string()
+        } else if parent == field || parent.ends_with(&format!(".{field}")) {
+            parent.clone()
+        } else {
+            format!("{parent}.{field}")
+        }
+    };
+    let field_in = |prefix: &str| {
+        message
+            .strip_prefix(prefix)
+            .and_then(|rest| rest.split('`').next())
+            .map(str::to_string)
+    };
+    if let Some(field) = field_in("unknown field `") {
+        return (join(&field), "unknown key".to_string());
+    }
+    if let Some(field) = field_in("missing field `") {
+        return (join(&field), "missing key".to_string());
+    }
+    let key = if parent.is_empty() {
+        "(top level)".to_string()
+    } else {
+        parent
+    };
+    (key, message.replace('\n', " "))
+}

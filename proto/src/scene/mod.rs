@@ -1,0 +1,25 @@
+//! Scene files (TOML, SI units): the types of `DESIGN.md` §5.1, loading with `--set` overrides, and validation.
+//!
+//! Every user error is a [`SceneError`]: one line naming the file, the dotted key and the problem.
+//!
+//! - `schema/`: the types a scene file is read into, one file per section;
+//! - `load.rs`: reading, `--set` overrides (`overrides.rs`) and serde errors with their full dotted key;
+//! - `validate.rs`: the checks of every value a solver relies on;
+//! - `grid.rs`: the FEM grid numbering of a solid;
+//! - [`sizing`]: counts and bytes of a run, estimated from the scene alone.
+//!
+//! Everything is re-exported here, so users name `cosim_proto::scene::Scene`, `cosim_proto::scene::parse`, ….
+
+mod grid;
+mod load;
+mod overrides;
+mod schema;
+pub mod sizing;
+mod validate;
+
+pub use load::{load, parse, LoadedScene, SceneError};
+pub use schema::{
+    BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf, EnergyPart,
+    FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec, ReferenceSpec, RunSpec,
+    Scene, SolidSpec, ISPH_APD_DEFAULT, SCENE_VERSION, WCSPH_APD_DEFAULT,
+};

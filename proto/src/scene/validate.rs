@@ -1,0 +1,399 @@
+//! Validation of a parsed scene: every value a solver relies on, checked in file order; the first problem found is
+//! returned as its dotted key and one line.
+
+use std::collections::HashSet;
+
+use super::schema::{BoxSpec, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, SCENE_VERSION};
+use super::sizing::Sizing;
+use crate::overlap;
+
+type Invalid = (String, String);
+
+fn check(ok: bool, key: impl FnOnce() -> String, message: impl FnOnce() -> String) -> Result<(), Invalid> {
+    if ok {
+        Ok(())
+    } else {
+        Err((key(), message()))
+    }
+}
+
+fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
+    check(
+        v.is_finite() && v > 0.0,
+        || key.to_string(),
+        || format!("must be a positive number, got {v}"),
+    )
+}
+
+/// The fluid section: positive sizes, a sensible smoothing ratio, blocks that hold particles and stay out of walls.
+fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Result<(), Invalid> {
+    finite_positive("fluid.density", f.density)?;
+    finite_positive("fluid.spacing", f.spacing)?;
+    check(
+        f.kinematic_viscosity.is_finite() && f.kinematic_viscosity >= 0.0,
+        || "fluid.kinematic_viscosity".into(),
+        || format!("must be zero or positive, got {}", f.kinematic_viscosity),
+    )?;
+    check(
+        (1.0..=2.0).contains(&f.smoothing_ratio),
+        || "fluid.smoothing_ratio".into(),
+        || format!("must be in [1, 2] (h = ratio x spacing), got {}", f.smoothing_ratio),
+    )?;
+    if let Some(c) = f.sound_speed {
+        finite_positive("fluid.sound_speed", c)?;
+    }
+    check(
+        f.cfl.is_finite() && f.cfl > 0.0 && f.cfl <= 1.0,
+        || "fluid.cfl".into(),
+        || {
+            format!(
+                "must be in (0, 1] (a factor on the stable step of DESIGN.md §4.2/§4.3; above 1 the fluid is \
+                 stepped past its stability limit), got {}",
+                f.cfl
+            )
+        },
+    )?;
+    check(
+        f.artificial_viscosity.is_finite() && f.artificial_viscosity >= 0.0,
+        || "fluid.artificial_viscosity".into(),
+        || format!("must be zero or positive, got {}", f.artificial_viscosity),
+    )?;
+    check(
+        f.density_filter_interval >= 1,
+        || "fluid.density_filter_interval".into(),
+        || "must be at least 1".into(),
+    )?;
+    check(
+        f.xsph.is_finite() && (0.0..=1.0).contains(&f.xsph),
+        || "fluid.xsph".into(),
+        || format!("must be in [0, 1], got {}", f.xsph),
+    )?;
+    check(
+        f.apd().is_finite() && (0.0..=1.0).contains(&f.apd()),
+        || "fluid.apd".into(),
+        || format!("must be in [0, 1], got {}", f.apd()),
+    )?;
+    check(
+        f.density_diffusion.is_finite() && (0.0..=1.0).contains(&f.density_diffusion),
+        || "fluid.density_diffusion".into(),
+        || {
+            format!(
+                "must be in [0, 1] (δ of δ-SPH; 0.1 is usual), got {}",
+                f.density_diffusion
+            )
+        },
+    )?;
+    check(
+        f.density_diffusion == 0.0 || f.solver == FluidSolver::Wcsph,
+        || "fluid.density_diffusion".into(),
+        || "applies to solver = \"wcsph\" only (ISPH takes its pressure from the Poisson equation)".into(),
+    )?;
+    if f.solver == FluidSolver::Isph {
+        check(
+            f.density_filter() == DensityFilter::None,
+            || "fluid.density_filter".into(),
+            || "ISPH takes no density filter (its pressure comes from the Poisson equation); set \"none\"".into(),
+        )?;
+    } else {
+        check(
+            f.ppe_source.is_none(),
+            || "fluid.ppe_source".into(),
+            || "applies to solver = \"isph\" only".into(),
+        )?;
+    }
+    check(
+        !f.blocks.is_empty(),
+        || "fluid.block".into(),
+        || "at least one [[fluid.block]] is needed".into(),
+    )?;
+    for (b, block) in f.blocks.iter().enumerate() {
+        let key = || format!("fluid.block[{b}]");
+        check(
+            (0..2).all(|k| block.min[k].is_finite() && block.max[k].is_finite()),
+            key,
+            || "corners must be finite".into(),
+        )?;
+        check((0..2).all(|k| block.max[k] - block.min[k] >= f.spacing), key, || {
+            format!(
+                "holds no particle: min {:?} max {:?} is narrower than the spacing {}",
+                block.min, block.max, f.spacing
+            )
+        })?;
+        for (w, wall) in walls.iter().enumerate() {
+            // Overlap of more than half a spacing in both directions: particles would sit inside the wall.
+            let overlap =
+                (0..2).all(|k| block.max[k].min(wall.max[k]) - block.min[k].max(wall.min[k]) > 0.5 * f.spacing);
+            check(!overlap, key, || {
+                format!("overlaps wall[{w}] (min {:?} max {:?})", wall.min, wall.max)
+            })?;
+        }
+        for solid in solids {
+            // The same rule against a solid's rectangle: particles inside a structure would be pushed out by
+            // the contact in the first step, with an impulse no physics asked for.
+            let overlap =
+                (0..2).all(|k| block.max[k].min(solid.max[k]) - block.min[k].max(solid.min[k]) > 0.5 * f.spacing);
+            check(!overlap, key, || {
+                format!(
+                    "overlaps solid `{}` (min {:?} max {:?})",
+                    solid.name, solid.min, solid.max
+                )
+            })?;
+        }
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Checks every value a solver relies on. Returns the dotted key and the problem.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        check(
+            self.version == SCENE_VERSION,
+            || "version".into(),
+            || {
+                format!(
+                    "this build reads version {SCENE_VERSION}, the file says {}",
+                    self.version
+                )
+            },
+        )?;
+        check(
+            !self.run.name.trim().is_empty(),
+            || "run.name".into(),
+            || "must not be empty".into(),
+        )?;
+        check(
+            self.fluid.is_some() || self.walls.is_empty(),
+            || "wall".into(),
+            || "walls hold water: a scene with [[wall]] needs a [fluid]".into(),
+        )?;
+        check(
+            self.fluid.is_some() || !self.solids.is_empty(),
+            || "solid".into(),
+            || "nothing to run: the scene has no [[solid]] and no [fluid]".into(),
+        )?;
+        finite_positive("run.end_time", self.run.end_time)?;
+        finite_positive("run.output_interval", self.run.output_interval)?;
+        check(
+            self.run.gravity.iter().all(|g| g.is_finite()),
+            || "run.gravity".into(),
+            || "must be finite".into(),
+        )?;
+        finite_positive("coupling.max_dt", self.coupling.max_dt)?;
+        finite_positive("coupling.step_timeout", self.coupling.step_timeout)?;
+        check(
+            // Above 0.94 elongated tri3 meshes go unstable (their characteristic length is an estimate).
+            self.coupling.fem_cfl > 0.0 && self.coupling.fem_cfl <= 0.9,
+            || "coupling.fem_cfl".into(),
+            || format!("must be in (0, 0.9], got {}", self.coupling.fem_cfl),
+        )?;
+        if let Some(t) = self.contact.thickness {
+            finite_positive("contact.thickness", t)?;
+        }
+        check(
+            self.contact.sweeps >= 1,
+            || "contact.sweeps".into(),
+            || "must be at least 1".into(),
+        )?;
+        if let Some(fluid) = &self.fluid {
+            validate_fluid(fluid, &self.walls, &self.solids)?;
+        }
+        for (w, wall) in self.walls.iter().enumerate() {
+            check(
+                (0..2).all(|k| wall.min[k].is_finite() && wall.max[k].is_finite() && wall.max[k] > wall.min[k]),
+                || format!("wall[{w}].max"),
+                || {
+                    format!(
+                        "must be greater than min in every component, got min {:?} max {:?}",
+                        wall.min, wall.max
+                    )
+                },
+            )?;
+        }
+        let mut solids = HashSet::with_capacity(self.solids.len());
+        for (s, solid) in self.solids.iter().enumerate() {
+            Self::validate_solid(s, solid)?;
+            check(
+                solids.insert(solid.name.as_str()),
+                || format!("solid[{s}].name"),
+                || format!("`{}` is used by another solid", solid.name),
+            )?;
+        }
+        let rects: Vec<overlap::Rect> = self.solids.iter().map(|s| (s.min, s.max)).collect();
+        if let Some((a, b)) = overlap::first_overlap(&rects) {
+            let (first, second) = (&self.solids[a], &self.solids[b]);
+            return Err((
+                format!("solid[{b}]"),
+                format!(
+                    "`{}` (min {:?} max {:?}) overlaps solid[{a}] `{}` (min {:?} max {:?}): solids may touch along \
+                     an edge but not share area",
+                    second.name, second.min, second.max, first.name, first.min, first.max
+                ),
+            ));
+        }
+        let mut names = HashSet::with_capacity(self.probes.len());
+        for (p, probe) in self.probes.iter().enumerate() {
+            let key = |k: &str| format!("probe[{p}].{k}");
+            check(
+                !probe.name.trim().is_empty() && !probe.name.contains(','),
+                || key("name"),
+                || "must be non-empty and contain no comma".into(),
+            )?;
+            check(
+                names.insert(probe.name.as_str()),
+                || key("name"),
+                || format!("`{}` is used by another probe", probe.name),
+            )?;
+            let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
+            check(
+                probe.point.is_none_or(|p| finite(&p)),
+                || key("point"),
+                || format!("must be finite, got {:?}", probe.point.unwrap_or_default()),
+            )?;
+            check(
+                probe.x_max.is_none_or(f64::is_finite),
+                || key("x_max"),
+                || format!("must be finite, got {}", probe.x_max.unwrap_or_default()),
+            )?;
+            if let Some(name) = &probe.solid {
+                check(
+                    solids.contains(name.as_str()),
+                    || key("solid"),
+                    || format!("no solid named `{name}` (solids: {})", self.solid_names()),
+                )?;
+            }
+            match probe.kind {
+                ProbeKind::NodeDisplacement => {
+                    check(
+                        probe.solid.is_some(),
+                        || key("solid"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
+                    check(
+                        probe.point.is_some(),
+                        || key("point"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
+                    check(
+                        probe.component.is_some(),
+                        || key("component"),
+                        || "missing key (node_displacement)".into(),
+                    )?;
+                }
+                ProbeKind::Energy => {
+                    check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
+                }
+                ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure => {
+                    check(
+                        self.fluid.is_some(),
+                        || key("kind"),
+                        || "needs a [fluid] in the scene".into(),
+                    )?;
+                    let (needed, present) = match probe.kind {
+                        ProbeKind::SurgeFront => ("component", probe.component.is_some()),
+                        ProbeKind::ColumnHeight => ("x_max", probe.x_max.is_some_and(f64::is_finite)),
+                        _ => ("point", probe.point.is_some()),
+                    };
+                    check(
+                        present,
+                        || key(needed),
+                        || format!("missing key ({:?})", probe.kind).to_lowercase(),
+                    )?;
+                    if let (ProbeKind::ColumnHeight, Some(x_max), Some(fluid)) = (probe.kind, probe.x_max, &self.fluid)
+                    {
+                        // The first column of particles of a block is half a spacing inside it (sph-node setup).
+                        let first = fluid
+                            .blocks
+                            .iter()
+                            .map(|b| b.min[0] + 0.5 * fluid.spacing)
+                            .fold(f64::INFINITY, f64::min);
+                        check(
+                            x_max >= first,
+                            || key("x_max"),
+                            || {
+                                format!(
+                                    "{x_max} is left of every fluid particle (the first are at x = {first}): the \
+                                     column would be empty from the start"
+                                )
+                            },
+                        )?;
+                    }
+                }
+            }
+            if let Some(r) = &probe.reference {
+                finite_positive(&key("reference.scale"), r.scale.abs())?;
+                for (k, v) in [("t_scale", r.t_scale), ("t_offset", r.t_offset)] {
+                    check(
+                        v.is_finite(),
+                        || key(&format!("reference.{k}")),
+                        || format!("must be finite, got {v}"),
+                    )?;
+                }
+            }
+        }
+        // Last: the counts are meaningful once every number above is known to be finite and positive.
+        Sizing::of(self).check_counts()
+    }
+
+    fn solid_names(&self) -> String {
+        if self.solids.is_empty() {
+            return "none".into();
+        }
+        self.solids
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
+        let key = |k: &str| format!("solid[{s}].{k}");
+        check(
+            !solid.name.trim().is_empty(),
+            || key("name"),
+            || "must not be empty".into(),
+        )?;
+        for k in 0..2 {
+            check(
+                solid.min[k].is_finite() && solid.max[k].is_finite() && solid.max[k] > solid.min[k],
+                || key("max"),
+                || {
+                    format!(
+                        "must be greater than min in every component, got min {:?} max {:?}",
+                        solid.min, solid.max
+                    )
+                },
+            )?;
+            check(
+                solid.divisions[k] > 0,
+                || key("divisions"),
+                || format!("must be at least 1 in every component, got {:?}", solid.divisions),
+            )?;
+        }
+        let m = &solid.material;
+        finite_positive(&key("material.density"), m.density)?;
+        finite_positive(&key("material.youngs_modulus"), m.youngs_modulus)?;
+        check(
+            m.poisson_ratio.is_finite() && (0.0..0.5).contains(&m.poisson_ratio),
+            || key("material.poisson_ratio"),
+            || format!("must be in [0, 0.5), got {}", m.poisson_ratio),
+        )?;
+        check(
+            solid.damping.is_finite() && solid.damping >= 0.0,
+            || key("damping"),
+            || format!("must be zero or positive, got {}", solid.damping),
+        )?;
+        for (f, b) in solid.fixed.iter().enumerate() {
+            check(
+                b.min.iter().chain(&b.max).all(|v| v.is_finite()),
+                || key(&format!("fixed[{f}]")),
+                || format!("corners must be finite, got min {:?} max {:?}", b.min, b.max),
+            )?;
+            check(
+                solid.has_node_in(b),
+                || key(&format!("fixed[{f}]")),
+                || format!("box min {:?} max {:?} holds no node of the mesh", b.min, b.max),
+            )?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,186 @@
+//! The content checks of each message type: what passes, and the one line naming what does not.
+
+use super::*;
+
+fn mesh() -> FemMesh {
+    FemMesh {
+        solid_names: vec!["plate".into()],
+        nodes: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        masses: vec![0.25; 4],
+        node_solid: vec![0; 4],
+        cells: vec![vec![0, 1, 2, 3]],
+        cell_solid: vec![0],
+        interface: vec![
+            Segment { a: 0, b: 1 },
+            Segment { a: 1, b: 2 },
+            Segment { a: 2, b: 3 },
+            Segment { a: 3, b: 0 },
+        ],
+        fixed: vec![0, 1],
+        dt_stable: 1e-4,
+    }
+}
+
+#[test]
+fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
+    assert_eq!(mesh().validate(), Ok(()));
+    type Spoil = fn(&mut FemMesh);
+    let cases: Vec<(Spoil, &str)> = vec![
+        (
+            |m| m.interface[2].b = 4,
+            "fem/mesh interface[2][1] = 4: out of range (4 nodes)",
+        ),
+        (
+            |m| m.masses.truncate(3),
+            "fem/mesh masses = 3 entries: one per node expected: 4",
+        ),
+        (
+            |m| m.masses[1] = -1.0,
+            "fem/mesh masses[1] = -1.0: must be a finite number > 0",
+        ),
+        (
+            |m| m.nodes[3][1] = f64::NAN,
+            "fem/mesh nodes[3][1] = NaN: not a finite number",
+        ),
+        (
+            |m| m.cells[0][3] = 7,
+            "fem/mesh cells[0][3] = 7: out of range (4 nodes)",
+        ),
+        (
+            |m| m.node_solid[2] = 1,
+            "fem/mesh node_solid[2] = 1: out of range (1 solids)",
+        ),
+        (
+            |m| m.cell_solid[0] = 3,
+            "fem/mesh cell_solid[0] = 3: out of range (1 solids)",
+        ),
+        (|m| m.fixed.push(9), "fem/mesh fixed[2] = 9: out of range (4 nodes)"),
+        (
+            |m| m.dt_stable = 0.0,
+            "fem/mesh dt_stable = 0.0: must be a finite number > 0",
+        ),
+        (
+            |m| m.dt_stable = f64::NAN,
+            "fem/mesh dt_stable = NaN: must be a finite number > 0",
+        ),
+    ];
+    for (spoil, want) in cases {
+        let mut m = mesh();
+        spoil(&mut m);
+        assert_eq!(m.validate().unwrap_err().to_string(), want);
+    }
+}
+
+#[test]
+fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
+    let m = mesh();
+    let ids = m.interface_nodes();
+    let asked = Asked {
+        interface: true,
+        snapshot: false,
+        interface_ids: &ids,
+    };
+    let state = FemState {
+        ids: ids.clone(),
+        x: m.nodes.clone(),
+        v: vec![[0.0; 2]; 4],
+        substeps: 1,
+        dt_stable: 1e-4,
+        compute_seconds: 0.0,
+        snapshot: None,
+    };
+    assert_eq!(state.validate(&m, asked), Ok(()));
+    let mut wrong = state.clone();
+    wrong.ids[2] = 168;
+    // The message the broker gave before named two equal counts ("reported 4 …, the mesh has 4").
+    assert_eq!(
+        wrong.validate(&m, asked).unwrap_err().to_string(),
+        "fem/state ids[2] = 168: the mesh's interface node 2 is node 2"
+    );
+    let mut nan = state.clone();
+    nan.v[1][0] = f64::INFINITY;
+    let e = nan.validate(&m, asked).unwrap_err();
+    assert!(e.is_non_finite());
+    assert_eq!(e.to_string(), "fem/state v[1][0] = inf: not a finite number");
+    let no_snapshot = Asked {
+        snapshot: true,
+        ..asked
+    };
+    assert_eq!(
+        state.validate(&m, no_snapshot).unwrap_err().to_string(),
+        "fem/state snapshot = none: asked for at an output time"
+    );
+}
+
+#[test]
+fn fluid_ids_must_be_in_range_ascending_and_once() {
+    let setup = SphSetup {
+        particles: 3,
+        spacing: 0.01,
+        h: 0.013,
+        density: 1000.0,
+        walls: vec![],
+        dt_stable: 1e-4,
+    };
+    let asked = Asked {
+        interface: true,
+        snapshot: false,
+        interface_ids: &[],
+    };
+    let state = |ids: Vec<u32>| SphState {
+        x: vec![[0.0; 2]; ids.len()],
+        v: vec![[0.0; 2]; ids.len()],
+        m: vec![0.1; ids.len()],
+        ids,
+        substeps: 1,
+        dt_stable: 1e-4,
+        compute_seconds: 0.0,
+        snapshot: None,
+    };
+    assert_eq!(state(vec![0, 2]).validate(&setup, asked), Ok(()));
+    assert_eq!(
+        state(vec![0, 3]).validate(&setup, asked).unwrap_err().to_string(),
+        "sph/state ids[1] = 3: out of range (3 particles)"
+    );
+    assert_eq!(
+        state(vec![2, 2]).validate(&setup, asked).unwrap_err().to_string(),
+        "sph/state ids[1] = 2: ids must be ascending, each once"
+    );
+    let mut zero_dt = state(vec![1]);
+    zero_dt.dt_stable = 0.0;
+    assert_eq!(
+        zero_dt.validate(&setup, asked).unwrap_err().to_string(),
+        "sph/state dt_stable = 0.0: a stable step must be > 0"
+    );
+}
+
+#[test]
+fn a_command_longer_than_max_dt_or_for_an_unknown_id_is_refused() {
+    let cmd = StepCommand {
+        dt: 1e-4,
+        corrections: vec![Correction {
+            id: 3,
+            dx: [0.0; 2],
+            dv: [1.0, 0.0],
+        }],
+        roi: None,
+        want_interface: true,
+        want_snapshot: false,
+        stop: false,
+    };
+    assert_eq!(cmd.validate("broker/fem", 4, 1e-4), Ok(()));
+    assert_eq!(
+        cmd.validate("broker/fem", 3, 1e-4).unwrap_err().to_string(),
+        "broker/fem corrections.id[0] = 3: out of range (3 ids)"
+    );
+    let long = StepCommand {
+        dt: 1e300,
+        ..cmd.clone()
+    };
+    assert_eq!(
+        long.validate("broker/sph", 4, 1e-4).unwrap_err().to_string(),
+        "broker/sph dt = 1e300: a step is between 0 and coupling.max_dt = 0.0001 s"
+    );
+    let nan = StepCommand { dt: f64::NAN, ..cmd };
+    assert!(nan.validate("broker/sph", 4, 1e-4).is_err());
+}
