@@ -11,17 +11,21 @@ use crate::contact::grid::CellGrid;
 /// before. Not serialisable, by design.
 #[derive(Clone, Debug, Default)]
 pub struct ParticleElementWorkspace {
-    /// Set-up: the segments binned in cells, the node → segment tables, 1/m per node.
+    /// The segments binned in cells (set-up).
     pub(super) grid: CellGrid,
+    /// Node → segment tables (set-up).
     pub(super) topo: Topology,
+    /// 1/m per node, 0 for a fixed one (set-up).
     pub(super) inv_m: Vec<f64>,
     /// Per particle: corrected, and what the position phase learnt.
     pub(super) marks: Vec<Mark>,
-    /// The masters near the particle being visited, and (position phase) the immovable ones of them.
+    /// The masters near the particle being visited (position phase, touching set).
     pub(super) masters: Vec<Master>,
+    /// The immovable ones of them (position phase).
     pub(super) rigid: Vec<Master>,
-    /// The touching set, and (velocity phase) one particle's immovable contacts.
+    /// The touching set: the velocity phase's contacts.
     pub(super) contacts: Vec<Contact>,
+    /// The immovable contacts of the particle being visited (velocity phase).
     pub(super) planes: Planes,
     /// Visit every particle in every sweep even where the nodes are static (tests compare the two).
     pub(super) exhaustive: bool,
