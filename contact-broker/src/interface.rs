@@ -3,9 +3,9 @@
 //! corrections both nodes apply before the next step. Pure: wire messages in, wire messages out.
 
 use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState};
-use cosim_proto::scene::{ContactAlgorithm, Scene};
+use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
-use crate::contact::{self, ContactWorkspace};
+use crate::contact::{self, ContactAlgorithm};
 
 /// What one contact pass did, for `summary.json` `contact_stats` and the frames.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -33,18 +33,16 @@ pub struct Corrections {
 
 /// The interface between the structure's boundary segments and the fluid particles.
 pub struct Interface {
-    algorithm: ContactAlgorithm,
+    /// The `[contact] algorithm`, with its parameters and scratch memory.
+    algorithm: Box<dyn ContactAlgorithm>,
     /// FE ids of the interface nodes, ascending (the order `fem-node` reports them in).
     node_ids: Vec<u32>,
     /// Segments as indices into `node_ids`.
     segments: Vec<contact::Segment>,
     masses: Vec<f64>,
     fixed: Vec<bool>,
-    element: contact::ContactParams,
-    particle: contact::ParticleParticleParams,
     /// How far outside the structure's bounding box particles are reported.
     margin: f64,
-    workspace: ContactWorkspace,
     /// Contact impulse of the last pass per FE node [N·s/m], for the interface load.
     impulse: Vec<[f64; 2]>,
     dt: f64,
@@ -90,48 +88,24 @@ impl Interface {
             .collect();
         let dx = sph.spacing;
         let thickness = scene.contact.thickness.unwrap_or(0.5 * dx);
-        let sweeps = scene.contact.sweeps;
-        // Monaghan (1994): D ≈ 5 g H with H the deepest water, r0 = Δx (DESIGN.md §4.6).
-        let depth = scene.fluid.as_ref().map_or(0.0, |f| {
-            f.blocks.iter().map(|b| b.max[1] - b.min[1]).fold(0.0, f64::max)
-        });
-        let g = scene.run.gravity[0].hypot(scene.run.gravity[1]);
-        // Far-side limit r_c + Δx, but never more than r_c + half the thinnest solid: a particle resting r_c in
-        // front of one face lies T + r_c behind the opposite face of a solid T thick, so d_max must stay below that
-        // or the opposite face's segments take it for a particle through them and throw it across (the 5 mm gate
-        // at Δx ≥ 5 mm did, at its first steps).
-        let thinnest = scene
-            .solids
-            .iter()
-            .map(|s| (s.max[0] - s.min[0]).min(s.max[1] - s.min[1]))
-            .fold(f64::INFINITY, f64::min);
-        let element = contact::ContactParams {
-            thickness,
-            far_side: thickness + dx.min(0.5 * thinnest),
-            sweeps,
-            move_masters: scene.contact.move_structure,
-            ..contact::ContactParams::for_spacing(dx)
-        };
-        // Monaghan (1994) with r0 = r_c rather than Δx: the fluid's particles start Δx/2 from the structure's
-        // surface, so with r0 = Δx every one of them would start deep inside the force range (a ∝ (r0/r)^12).
-        // Boundary points at r0/2 so that no particle slips between two of them.
-        let particle = contact::ParticleParticleParams {
-            r0: thickness,
-            spacing: 0.5 * thickness,
-            ..contact::ParticleParticleParams::monaghan(dx, g, depth)
+        let algorithm: Box<dyn ContactAlgorithm> = match scene.contact.algorithm {
+            ContactChoice::ParticleElement => {
+                Box::new(contact::ParticleElement::new(element_params(scene, dx, thickness)))
+            }
+            ContactChoice::ParticleParticle => {
+                Box::new(contact::ParticleParticle::new(particle_params(scene, dx, thickness)))
+            }
+            ContactChoice::None => Box::new(()),
         };
         Ok(Self {
-            algorithm: scene.contact.algorithm,
+            algorithm,
             node_ids,
             segments,
             masses,
             fixed,
-            element,
-            particle,
             // A particle moves less than h in one step (CFL), so one outside the box inflated by 2h plus the
             // contact range cannot reach a segment before the next pass.
             margin: 2.0 * sph.h + thickness.max(dx) + dx,
-            workspace: ContactWorkspace::default(),
             impulse: vec![[0.0; 2]; mesh.nodes.len()],
             dt: 0.0,
         })
@@ -144,7 +118,7 @@ impl Interface {
 
     /// Whether contact is computed at all (`[contact] algorithm` not `none`).
     pub fn active(&self) -> bool {
-        self.algorithm != ContactAlgorithm::None
+        self.algorithm.active()
     }
 
     /// The region of interest `[x0, y0, x1, y1]`: the bounding box of the interface nodes at `x`, inflated by
@@ -213,34 +187,10 @@ impl Interface {
                 m: &self.masses,
                 fixed: &self.fixed,
             };
-            match self.algorithm {
-                ContactAlgorithm::ParticleElement => {
-                    let mut report = contact::particle_element_with(
-                        &mut self.workspace,
-                        particles,
-                        nodes,
-                        &self.segments,
-                        &self.element,
-                    )?;
-                    stats.contacts = report.contacts;
-                    stats.max_penetration = report.max_penetration;
-                    std::mem::take(&mut report.node_impulse)
-                }
-                ContactAlgorithm::ParticleParticle => {
-                    let report = contact::particle_particle_with(
-                        &mut self.workspace,
-                        particles,
-                        nodes,
-                        &self.segments,
-                        &self.particle,
-                        dt,
-                    )?;
-                    stats.contacts = report.contacts;
-                    stats.max_penetration = report.max_penetration;
-                    report.node_impulse
-                }
-                ContactAlgorithm::None => unreachable!("checked above"),
-            }
+            let report = self.algorithm.correct(particles, nodes, &self.segments, dt)?;
+            stats.contacts = report.contacts;
+            stats.max_penetration = report.max_penetration;
+            report.node_impulse
         };
         tracing::debug!(
             contacts = stats.contacts,
@@ -261,6 +211,43 @@ impl Interface {
             sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv)),
         };
         Ok((corrections, stats))
+    }
+}
+
+/// The particle–element parameters of `scene` for particle spacing `dx` and contact thickness r_c = `thickness`.
+fn element_params(scene: &Scene, dx: f64, thickness: f64) -> contact::ContactParams {
+    // Far-side limit r_c + Δx, but never more than r_c + half the thinnest solid: a particle resting r_c in front of
+    // one face lies T + r_c behind the opposite face of a solid T thick, so d_max must stay below that or the
+    // opposite face's segments take it for a particle through them and throw it across (the 5 mm gate at Δx ≥ 5 mm
+    // did, at its first steps).
+    let thinnest = scene
+        .solids
+        .iter()
+        .map(|s| (s.max[0] - s.min[0]).min(s.max[1] - s.min[1]))
+        .fold(f64::INFINITY, f64::min);
+    contact::ContactParams {
+        thickness,
+        far_side: thickness + dx.min(0.5 * thinnest),
+        sweeps: scene.contact.sweeps,
+        move_masters: scene.contact.move_structure,
+        ..contact::ContactParams::for_spacing(dx)
+    }
+}
+
+/// The particle–particle parameters of `scene` for particle spacing `dx` and contact thickness r_c = `thickness`.
+fn particle_params(scene: &Scene, dx: f64, thickness: f64) -> contact::ParticleParticleParams {
+    // Monaghan (1994): D ≈ 5 g H with H the deepest water, r0 = Δx (DESIGN.md §4.6).
+    let depth = scene.fluid.as_ref().map_or(0.0, |f| {
+        f.blocks.iter().map(|b| b.max[1] - b.min[1]).fold(0.0, f64::max)
+    });
+    let g = scene.run.gravity[0].hypot(scene.run.gravity[1]);
+    // Monaghan (1994) with r0 = r_c rather than Δx: the fluid's particles start Δx/2 from the structure's surface,
+    // so with r0 = Δx every one of them would start deep inside the force range (a ∝ (r0/r)^12). Boundary points at
+    // r0/2 so that no particle slips between two of them.
+    contact::ParticleParticleParams {
+        r0: thickness,
+        spacing: 0.5 * thickness,
+        ..contact::ParticleParticleParams::monaghan(dx, g, depth)
     }
 }
 

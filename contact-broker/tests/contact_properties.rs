@@ -17,8 +17,8 @@
 //! Set `CONTACT_REPORT=1` to print the measured errors (`cargo test -- --nocapture`).
 
 use contact_broker::contact::{
-    particle_element, particle_element_with, particle_particle, ContactParams, ContactReport, ContactWorkspace, Nodes,
-    ParticleParticleParams, ParticleParticleReport, Particles, Segment,
+    particle_element, particle_element_with, particle_particle, ContactParams, ContactReport, Nodes,
+    ParticleElementWorkspace, ParticleParticleParams, ParticleParticleReport, Particles, Segment,
 };
 use proptest::prelude::*;
 
@@ -427,7 +427,7 @@ proptest! {
         prop_assert_eq!(bits(&a.pv[n_near..]), bits(&sc.pv[n_near..]));
 
         // Same input, a workspace that served another scene first.
-        let mut ws = ContactWorkspace::default();
+        let mut ws = ParticleElementWorkspace::default();
         let mut other = sc.clone();
         other.px.truncate(3);
         other.pv.truncate(3);

@@ -29,6 +29,12 @@ pub(crate) fn cross(a: Vec2, b: Vec2) -> f64 {
     a[0] * b[1] - a[1] * b[0]
 }
 
+/// y + a x.
+#[inline]
+pub(crate) fn axpy(y: Vec2, a: f64, x: Vec2) -> Vec2 {
+    [y[0] + a * x[0], y[1] + a * x[1]]
+}
+
 #[inline]
 pub(crate) fn norm(a: Vec2) -> f64 {
     // Not `hypot`: it is several times slower and the coordinates here are far from overflow.

@@ -3,9 +3,11 @@
 //! Lennard-Jones force. Each reaction goes to the structure, spread on the segment's nodes with N1, N2, so linear
 //! and angular momentum are conserved.
 
+use super::algorithm::{ContactAlgorithm, PassReport};
+use super::bodies::{validate, Nodes, Particles, Segment};
+use super::error::{param, ContactError};
 use super::geometry::{dot, sub, Vec2};
-use super::workspace::ContactWorkspace;
-use super::{param, validate, ContactError, Nodes, Particles, Segment};
+use super::grid::CellGrid;
 
 /// Parameters of the particle–particle contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,12 +78,25 @@ pub struct ParticleParticleReport {
 
 /// A boundary particle: the point N_a x_a + N_b x_b of a segment (a node: a = b, N_a = 1, N_b = 0).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct BoundaryPoint {
+struct BoundaryPoint {
     x: Vec2,
     a: usize,
     b: usize,
     na: f64,
     nb: f64,
+}
+
+/// Scratch arrays of [`particle_particle_with`]: keep one per caller and pass it to every call so the arrays are
+/// allocated once. Holds no state between calls: results never depend on what it held before. Not serialisable, by
+/// design.
+#[derive(Clone, Debug, Default)]
+pub struct ParticleParticleWorkspace {
+    /// The boundary points binned in cells.
+    grid: CellGrid,
+    /// The boundary points: the nodes used by a segment, then the points along each segment.
+    points: Vec<BoundaryPoint>,
+    /// Per node: used by a segment.
+    touched: Vec<bool>,
 }
 
 /// Applies Δt times the repulsive acceleration to the particles' velocities and the reactions to the nodes (free
@@ -93,12 +108,19 @@ pub fn particle_particle(
     params: &ParticleParticleParams,
     dt: f64,
 ) -> Result<ParticleParticleReport, ContactError> {
-    particle_particle_with(&mut ContactWorkspace::default(), particles, nodes, segments, params, dt)
+    particle_particle_with(
+        &mut ParticleParticleWorkspace::default(),
+        particles,
+        nodes,
+        segments,
+        params,
+        dt,
+    )
 }
 
 /// [`particle_particle`] reusing the scratch arrays of `ws`.
 pub fn particle_particle_with(
-    ws: &mut ContactWorkspace,
+    ws: &mut ParticleParticleWorkspace,
     particles: Particles<'_>,
     nodes: Nodes<'_>,
     segments: &[Segment],
@@ -108,9 +130,7 @@ pub fn particle_particle_with(
     params.validate()?;
     param("dt", dt, dt >= 0.0, "non-negative and finite")?;
     validate(&particles, &nodes, segments)?;
-    let ContactWorkspace {
-        grid, points, touched, ..
-    } = ws;
+    let ParticleParticleWorkspace { grid, points, touched } = ws;
     let nn = nodes.x.len();
     let mut report = ParticleParticleReport {
         node_impulse: vec![[0.0; 2]; nn],
@@ -205,6 +225,42 @@ pub fn particle_particle_with(
         }
     }
     Ok(report)
+}
+
+/// The particle–particle algorithm with its parameters and its scratch memory.
+#[derive(Clone, Debug, Default)]
+pub struct ParticleParticle {
+    /// The parameters of every pass.
+    pub params: ParticleParticleParams,
+    workspace: ParticleParticleWorkspace,
+}
+
+impl ParticleParticle {
+    /// The algorithm with `params` and an empty workspace.
+    pub fn new(params: ParticleParticleParams) -> Self {
+        ParticleParticle {
+            params,
+            workspace: ParticleParticleWorkspace::default(),
+        }
+    }
+}
+
+impl ContactAlgorithm for ParticleParticle {
+    /// [`particle_particle_with`] over the coupling step `dt`.
+    fn correct(
+        &mut self,
+        particles: Particles<'_>,
+        nodes: Nodes<'_>,
+        segments: &[Segment],
+        dt: f64,
+    ) -> Result<PassReport, ContactError> {
+        let report = particle_particle_with(&mut self.workspace, particles, nodes, segments, &self.params, dt)?;
+        Ok(PassReport {
+            contacts: report.contacts,
+            max_penetration: report.max_penetration,
+            node_impulse: report.node_impulse,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! one plain Gauss–Seidel step on the deepest violation is returned instead and the caller repeats.
 
 use super::detection::{Detector, Master, Shape};
-use super::geometry::{add, cross, dot, normalize, scale, sub, Vec2};
+use crate::contact::geometry::{add, cross, dot, normalize, scale, sub, Vec2};
 
 /// Constraints entering the candidate set (those violated at the start, and those violated after one single
 /// projection); beyond this many the rest is left to the caller's repeat.
@@ -218,8 +218,8 @@ pub(crate) fn velocity_step(planes: &[HalfPlane], v0: Vec2, tol: f64) -> Option<
 #[cfg(test)]
 mod tests {
     use super::super::detection::Topology;
-    use super::super::Segment;
     use super::*;
+    use crate::contact::bodies::Segment;
 
     /// A 60° tank bottom (V-shaped notch, fluid above): both walls concave at node 1.
     fn notch() -> (Vec<Vec2>, Vec<Segment>) {

@@ -1,8 +1,8 @@
 //! Contact detection (`DESIGN.md` §4.5): which master a slave particle touches — a boundary segment, or a boundary
 //! node at a convex corner or at the free end of an open chain — and the geometry of that contact.
 
-use super::geometry::{add, cross, dot, norm, normalize, scale, sub, xi, Frame, Vec2};
-use super::Segment;
+use crate::contact::bodies::Segment;
+use crate::contact::geometry::{add, cross, dot, norm, normalize, scale, sub, xi, Frame, Vec2};
 
 /// "No segment" in the node → segment tables.
 const NONE: u32 = u32::MAX;

@@ -1,0 +1,100 @@
+//! The position phase (`DESIGN.md` §4.5 "Position"): Gauss–Seidel sweeps over the particles in index order, each
+//! particle's masters in segment order, that push every penetrating particle out to the contact thickness and move
+//! the master nodes by their share (λ = −g/w); against immovable masters the exact limit of the sweeps instead
+//! (`projection.rs`).
+
+use super::detection::{Hit, Master};
+use super::projection;
+use super::report::ContactReport;
+use super::setup::{Mark, Setup};
+use crate::contact::bodies::{Nodes, Particles};
+use crate::contact::geometry::{axpy, Vec2};
+
+/// Runs the position sweeps until a sweep's deepest penetration is within `tol_x` or `params.sweeps` are done.
+/// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them.
+///
+/// While every master is immovable in this phase (masters held, or all nodes fixed: `Setup::nodes_static`), the
+/// nodes do not move, so a visit depends on nothing but the particle's own position. A particle that a visit left
+/// where it was is then skipped by the later sweeps, and one that also touched nothing in the first sweep by the
+/// touching set ([`touching`](super::touching)): they would repeat the same detection on the same inputs and find
+/// the same nothing (bit-identical result).
+pub(super) fn phase(
+    setup: &Setup,
+    particles: &mut Particles,
+    nodes: &mut Nodes,
+    masters: &mut Vec<Master>,
+    rigid: &mut Vec<Master>,
+    marks: &mut [Mark],
+    report: &mut ContactReport,
+) {
+    let pos_fixed = &*setup.pos_fixed;
+    for sweep in 0..setup.params.sweeps {
+        let first = sweep == 0;
+        let mut worst = 0.0f64;
+        for (s, mark) in marks.iter_mut().enumerate() {
+            if setup.nodes_static && !first && mark.still {
+                continue;
+            }
+            setup.gather(nodes.x, particles.x[s], masters);
+            mark.still = true;
+            if first {
+                mark.clear = true;
+            }
+            if masters.is_empty() {
+                continue;
+            }
+            rigid.clear();
+            let im_s = 1.0 / particles.m[s];
+            for &m in masters.iter() {
+                if setup.detector(nodes.x).is_rigid(m, pos_fixed) {
+                    rigid.push(m);
+                    continue;
+                }
+                let Some(h) = setup.detector(nodes.x).detect(m, particles.x[s]) else {
+                    continue;
+                };
+                if h.g >= 0.0 {
+                    continue;
+                }
+                worst = worst.max(-h.g);
+                if first {
+                    report.note_contact(m, h.g);
+                }
+                correct(setup, &h, im_s, &mut particles.x[s], nodes.x, report);
+                mark.corrected = true;
+            }
+            // Immovable masters: the exact limit of the sweeps, per particle.
+            let projected = projection::position(setup, particles, s, nodes.x, rigid, first, report);
+            worst = worst.max(projected.worst);
+            if projected.near {
+                mark.clear = false;
+            }
+            if projected.penetrated {
+                mark.still = false;
+            }
+            if projected.moved {
+                mark.corrected = true;
+            }
+        }
+        report.position_sweeps += 1;
+        if worst <= setup.tol_x {
+            break;
+        }
+    }
+}
+
+/// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`.
+fn correct(setup: &Setup, h: &Hit, im_s: f64, x_s: &mut Vec2, node_x: &mut [Vec2], report: &mut ContactReport) {
+    let (inv_m, pos_fixed) = (setup.inv_m, &*setup.pos_fixed);
+    // DESIGN.md §4.5: w = 1/m_s + N1²/m1 + N2²/m2 (a fixed node adds 0), λ = −g/w.
+    let w = im_s + h.na * h.na * inv_m[h.a] + h.nb * h.nb * inv_m[h.b];
+    let lam = -h.g / w;
+    // x_s += (λ/m_s) n; x1 −= (λ N1/m1) n; x2 −= (λ N2/m2) n.
+    *x_s = axpy(*x_s, lam * im_s, h.n);
+    for (k, nk) in [(h.a, h.na), (h.b, h.nb)] {
+        if !pos_fixed[k] && nk != 0.0 {
+            node_x[k] = axpy(node_x[k], -lam * nk * inv_m[k], h.n);
+        }
+        report.node_position_impulse[k] = axpy(report.node_position_impulse[k], -lam * nk, h.n);
+    }
+}

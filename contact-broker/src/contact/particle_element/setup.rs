@@ -1,0 +1,153 @@
+//! The set-up of one particle–element pass: the nodes' inverse masses, the segment grid, the tolerances, which
+//! nodes the position phase may move, and the detection context every phase shares; and what the pass knows about
+//! each particle ([`Mark`]).
+
+use std::borrow::Cow;
+
+use super::detection::{Detector, Master, Topology};
+use super::params::ContactParams;
+use crate::contact::bodies::{Nodes, Segment};
+use crate::contact::geometry::{sub, Vec2};
+use crate::contact::grid::CellGrid;
+
+/// What the pass knows about one particle: whether it was corrected, and what its position-phase visits learnt,
+/// for the skips that hold while the nodes are static.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Mark {
+    /// Its position or velocity was changed.
+    pub corrected: bool,
+    /// Its last position-phase visit left it where it was (no master penetrated at its position).
+    pub still: bool,
+    /// Its first-sweep visit found no master within the touch gap at its position.
+    pub clear: bool,
+}
+
+/// The context of one pass, fixed for its whole length (node positions are not in it: they change in the position
+/// phase).
+pub(super) struct Setup<'a> {
+    pub params: ContactParams,
+    pub segments: &'a [Segment],
+    topo: &'a Topology,
+    grid: &'a CellGrid,
+    /// 1/m per node, 0 for a fixed node.
+    pub inv_m: &'a [f64],
+    /// The fixed nodes (infinite mass).
+    pub fixed: &'a [bool],
+    /// The nodes the position phase leaves in place: the fixed ones, or all of them when the masters are held
+    /// (`move_masters` off).
+    pub pos_fixed: Cow<'a, [bool]>,
+    /// Every master immovable in the position phase, and no test asked for exhaustive visits: see
+    /// [`position::phase`](super::position::phase).
+    pub nodes_static: bool,
+    /// How far a segment's box is inflated for the candidate search.
+    inflate: f64,
+    /// Convergence tolerance of the position phase [m].
+    pub tol_x: f64,
+    /// Round-off allowance of the exact rigid projection [m] (16 ulp of the coordinates).
+    pub tol_round: f64,
+    /// Contacts within this gap after the position phase get the velocity correction [m].
+    pub touch: f64,
+    min_len: f64,
+}
+
+impl<'a> Setup<'a> {
+    /// Builds the node → segment tables, the inverse masses and the segment grid into the workspace's arrays and
+    /// derives the tolerances from `params` and the node coordinates. `segments` is not empty.
+    pub fn new(
+        grid: &'a mut CellGrid,
+        topo: &'a mut Topology,
+        inv_m: &'a mut Vec<f64>,
+        nodes: &Nodes<'a>,
+        segments: &'a [Segment],
+        params: &ContactParams,
+        exhaustive: bool,
+    ) -> Self {
+        let nn = nodes.x.len();
+        let fixed = nodes.fixed;
+        topo.build(nn, segments);
+        inv_m.clear();
+        inv_m.extend((0..nn).map(|k| if fixed[k] { 0.0 } else { 1.0 / nodes.m[k] }));
+
+        // Segments are binned with their boxes inflated by twice the detection reach, so that a particle's
+        // candidate list also covers the places an exact rigid projection may move it to.
+        let (r_c, d_max) = (params.thickness, params.far_side);
+        let inflate = 2.0 * r_c.max(d_max);
+        let mean_len = segments.iter().map(|s| dist(nodes.x[s.a], nodes.x[s.b])).sum::<f64>() / segments.len() as f64;
+        {
+            let x = &*nodes.x;
+            grid.build(segments.len(), inflate.max(mean_len), |j| {
+                let (a, b) = (x[segments[j].a], x[segments[j].b]);
+                let lo = [a[0].min(b[0]) - inflate, a[1].min(b[1]) - inflate];
+                let hi = [a[0].max(b[0]) + inflate, a[1].max(b[1]) + inflate];
+                (lo, hi)
+            });
+        }
+        let coord = nodes.x.iter().fold(0.0f64, |c, x| c.max(x[0].abs()).max(x[1].abs()));
+        // Convergence tolerance, and the round-off allowance of the exact rigid projection (16 ulp of the
+        // coordinates).
+        let tol_x = params.tolerance * r_c;
+        let tol_round = 1e-12 * r_c + 16.0 * f64::EPSILON * coord;
+        // Contacts within this gap after the position phase get the velocity correction (never below round-off).
+        let touch = tol_x.max(tol_round);
+
+        // Masters held in place (`move_masters` off) are immovable in the position phase: the exact rigid
+        // projection.
+        let pos_fixed = if params.move_masters {
+            Cow::Borrowed(fixed)
+        } else {
+            Cow::Owned(vec![true; nn])
+        };
+        let nodes_static = !exhaustive && pos_fixed.iter().all(|&f| f);
+        Setup {
+            params: *params,
+            segments,
+            topo,
+            grid,
+            inv_m,
+            fixed,
+            pos_fixed,
+            nodes_static,
+            inflate,
+            tol_x,
+            tol_round,
+            touch,
+            min_len: 1e-12 * r_c,
+        }
+    }
+
+    /// The detector at node positions `x`.
+    pub fn detector<'b>(&'b self, x: &'b [Vec2]) -> Detector<'b> {
+        Detector {
+            x,
+            segments: self.segments,
+            topo: self.topo,
+            thickness: self.params.thickness,
+            far_side: self.params.far_side,
+            min_len: self.min_len,
+            // The touch gap: no caller of `detect` here acts on a larger gap.
+            reach: self.touch,
+        }
+    }
+
+    /// The masters near `xs` (node positions `x`), in a fixed order: those of the segments in its grid cell whose
+    /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box).
+    pub fn gather(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
+        out.clear();
+        for &j in self.grid.query(xs) {
+            let s = self.segments[j as usize];
+            let (a, b) = (x[s.a], x[s.b]);
+            let inflate = self.inflate;
+            let outside = |k: usize| xs[k] < a[k].min(b[k]) - inflate || xs[k] > a[k].max(b[k]) + inflate;
+            if !(outside(0) || outside(1)) {
+                self.topo.masters_near(j as usize, s, out);
+            }
+        }
+    }
+}
+
+/// |a − b| (`hypot`: the mean segment length that sizes the grid).
+#[inline]
+pub(super) fn dist(a: Vec2, b: Vec2) -> f64 {
+    let d = sub(a, b);
+    d[0].hypot(d[1])
+}

@@ -1,0 +1,32 @@
+//! The scratch memory of the particle–element pass (`DESIGN.md` §2: state apart from scratch).
+
+use super::detection::{Master, Topology};
+use super::projection::Planes;
+use super::setup::Mark;
+use super::touching::Contact;
+use crate::contact::grid::CellGrid;
+
+/// Scratch arrays of [`particle_element_with`](super::particle_element_with): keep one per caller and pass it to
+/// every call so the arrays are allocated once. Holds no state between calls: results never depend on what it held
+/// before. Not serialisable, by design.
+#[derive(Clone, Debug, Default)]
+pub struct ParticleElementWorkspace {
+    /// The segments binned in cells (set-up).
+    pub(super) grid: CellGrid,
+    /// Node → segment tables (set-up).
+    pub(super) topo: Topology,
+    /// 1/m per node, 0 for a fixed one (set-up).
+    pub(super) inv_m: Vec<f64>,
+    /// Per particle: corrected, and what the position phase learnt.
+    pub(super) marks: Vec<Mark>,
+    /// The masters near the particle being visited (position phase, touching set).
+    pub(super) masters: Vec<Master>,
+    /// The immovable ones of them (position phase).
+    pub(super) rigid: Vec<Master>,
+    /// The touching set: the velocity phase's contacts.
+    pub(super) contacts: Vec<Contact>,
+    /// The immovable contacts of the particle being visited (velocity phase).
+    pub(super) planes: Planes,
+    /// Visit every particle in every sweep even where the nodes are static (tests compare the two).
+    pub(super) exhaustive: bool,
+}
