@@ -23,7 +23,6 @@ use crate::boundary::wall_guard::WallBoxes;
 use crate::corrections::{apd, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
-use crate::fluid_solver::{FluidSolver, SavedSolver};
 use crate::kernel::CubicSpline;
 use crate::neighbors::{CellList, NeighborList};
 use crate::params::SphParams;
@@ -31,6 +30,7 @@ use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup::{self, FluidSetup};
 
 mod diagnostics;
+mod fluid_solver;
 mod restore;
 mod source;
 
@@ -491,43 +491,5 @@ impl IsphSolver {
 
     fn unstable(&self, step: u64, particle: usize, reason: String) -> SphError {
         SphError::Unstable { step, particle, reason }
-    }
-}
-
-impl FluidSolver for IsphSolver {
-    fn name(&self) -> &'static str {
-        "isph"
-    }
-
-    fn params(&self) -> &SphParams {
-        IsphSolver::params(self)
-    }
-
-    fn state(&self) -> &FluidState {
-        IsphSolver::state(self)
-    }
-
-    fn state_mut(&mut self) -> &mut FluidState {
-        IsphSolver::state_mut(self)
-    }
-
-    fn walls(&self) -> &WallParticles {
-        IsphSolver::walls(self)
-    }
-
-    fn stable_dt(&self) -> f64 {
-        IsphSolver::stable_dt(self)
-    }
-
-    fn step(&mut self, dt: f64) -> Result<()> {
-        IsphSolver::step(self, dt)
-    }
-
-    fn save(&self) -> SavedSolver {
-        self.save_state()
-    }
-
-    fn restore(&mut self, saved: SavedSolver) -> std::result::Result<(), String> {
-        self.restore_state(saved)
     }
 }

@@ -27,7 +27,6 @@ use crate::boundary::wall_guard::WallBoxes;
 use crate::corrections::{apd, density_filter, mls, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
-use crate::fluid_solver::{FluidSolver, SavedSolver};
 use crate::integrator;
 use crate::kernel::CubicSpline;
 use crate::neighbors::{NeighborList, SortedCells};
@@ -40,6 +39,7 @@ use crate::wcsph::sorted::{update_vol, Sorted};
 use crate::wcsph::DensityDiffusion;
 
 mod diagnostics;
+mod fluid_solver;
 mod passes;
 mod restore;
 #[cfg(test)]
@@ -462,47 +462,5 @@ impl WcsphSolver {
 
     fn unstable(&self, step: u64, particle: usize, reason: String) -> SphError {
         SphError::Unstable { step, particle, reason }
-    }
-}
-
-impl FluidSolver for WcsphSolver {
-    fn name(&self) -> &'static str {
-        "wcsph"
-    }
-
-    fn params(&self) -> &SphParams {
-        WcsphSolver::params(self)
-    }
-
-    fn state(&self) -> &FluidState {
-        WcsphSolver::state(self)
-    }
-
-    fn state_mut(&mut self) -> &mut FluidState {
-        WcsphSolver::state_mut(self)
-    }
-
-    fn walls(&self) -> &WallParticles {
-        WcsphSolver::walls(self)
-    }
-
-    fn stable_dt(&self) -> f64 {
-        WcsphSolver::stable_dt(self)
-    }
-
-    fn step(&mut self, dt: f64) -> Result<()> {
-        WcsphSolver::step(self, dt)
-    }
-
-    fn wall_pushes(&self) -> Option<u64> {
-        Some(self.wall_pushes.0)
-    }
-
-    fn save(&self) -> SavedSolver {
-        self.save_state()
-    }
-
-    fn restore(&mut self, saved: SavedSolver) -> std::result::Result<(), String> {
-        self.restore_state(saved)
     }
 }
