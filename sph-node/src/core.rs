@@ -6,12 +6,15 @@ use std::time::Instant;
 
 use bincode::Options;
 use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
-use cosim_proto::scene::Scene;
+use cosim_proto::scene::{FluidSolver as SceneSolver, PpeSourceKind, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SphError;
-use crate::fluid_solver::{self, FluidSolver, SavedSolver};
+use crate::fluid_solver::{FluidSolver, SavedSolver};
+use crate::isph::{IsphSolver, PpeSource};
+use crate::setup;
 use crate::stability::EnergyGuard;
+use crate::wcsph::WcsphSolver;
 
 /// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9). Version 2: the
 /// solvers carry `fluid.cfl`; 3: the WCSPH solver carries its wall boxes and wall-guard count; 4: the neighbour lists
@@ -29,6 +32,21 @@ pub struct SphCheckpoint {
     pub guard: EnergyGuard,
 }
 
+/// The solver of `fluid.solver`.
+pub fn solver_from_scene(scene: &Scene) -> Result<Box<dyn FluidSolver>, SphError> {
+    let spec = setup::fluid_spec_any(scene)?;
+    Ok(match spec.solver {
+        SceneSolver::Wcsph => Box::new(WcsphSolver::new(scene)?),
+        SceneSolver::Isph => Box::new(IsphSolver::with_source(
+            scene,
+            match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
+                PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
+                PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
+            },
+        )?),
+    })
+}
+
 /// A fluid node: the solver plus what it tells the broker.
 pub struct SphCore {
     solver: Box<dyn FluidSolver>,
@@ -41,7 +59,7 @@ pub struct SphCore {
 impl SphCore {
     /// Fill the scene's fluid blocks and walls with particles.
     pub fn new(scene: &Scene) -> Result<Self, SphError> {
-        let solver = fluid_solver::from_scene(scene)?;
+        let solver = solver_from_scene(scene)?;
         let params = solver.params();
         let setup = SphSetup {
             particles: solver.state().len() as u32,

@@ -1,20 +1,16 @@
 //! [`FluidSolver`]: what the fluid node asks of a solver, whichever method it uses (WCSPH, [`crate::wcsph`]; ISPH,
 //! [`crate::isph`]), as salva's `PressureSolver`. A third method is a folder with its step and its data and an
-//! implementation of this trait; [`from_scene`] picks it by `fluid.solver`.
+//! implementation of this trait; [`crate::core::solver_from_scene`] picks it by `fluid.solver`.
 //!
 //! A solver's state for a checkpoint is [`SavedSolver`]: the particles ([`FluidState`]), the walls, and what else
 //! the method carries from one step to the next, in its own encoding. Nothing that a step rebuilds (neighbour
 //! lists, cell order, scratch) is saved: [`FluidSolver::restore`] rebuilds it as a step would.
 
-use cosim_proto::scene::{FluidSolver as SceneSolver, PpeSourceKind, Scene};
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 use crate::error::Result;
-use crate::isph::{IsphSolver, PpeSource};
 use crate::params::SphParams;
 use crate::particles::{FluidState, WallParticles};
-use crate::setup;
-use crate::wcsph::WcsphSolver;
 
 /// A fluid solver: particles, walls, and the step that advances them.
 pub trait FluidSolver: Send + Sync {
@@ -70,23 +66,8 @@ pub struct SavedSolver {
     pub own: Vec<u8>,
 }
 
-/// The solver of `fluid.solver`.
-pub fn from_scene(scene: &Scene) -> Result<Box<dyn FluidSolver>> {
-    let spec = setup::fluid_spec_any(scene)?;
-    Ok(match spec.solver {
-        SceneSolver::Wcsph => Box::new(WcsphSolver::new(scene)?),
-        SceneSolver::Isph => Box::new(IsphSolver::with_source(
-            scene,
-            match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
-                PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
-                PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
-            },
-        )?),
-    })
-}
-
 /// A method's own part of [`SavedSolver`], in the checkpoint's encoding (bincode, fixed-width integers).
-pub(crate) fn encode<T: Serialize>(own: &T) -> Vec<u8> {
+pub fn encode<T: Serialize>(own: &T) -> Vec<u8> {
     bincode::serialize(own).expect("in-memory bincode encoding of plain data")
 }
 

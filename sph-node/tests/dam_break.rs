@@ -16,7 +16,8 @@
 
 mod common;
 
-use sph_node::fluid_solver::{self, FluidSolver};
+use sph_node::core::solver_from_scene;
+use sph_node::FluidSolver;
 
 const A: f64 = 0.1;
 const G: f64 = 9.81;
@@ -84,7 +85,7 @@ fn front(fluid: &dyn FluidSolver, dx: f64) -> f64 {
 /// Runs to T = 2.6 at Δx = a/40 and returns (T, Z) every step.
 fn surge(extra: &str) -> Vec<(f64, f64)> {
     let dx = A / 40.0;
-    let mut fluid = fluid_solver::from_scene(&common::dam_break(A, 5.0 * A, dx, extra)).expect("solver");
+    let mut fluid = solver_from_scene(&common::dam_break(A, 5.0 * A, dx, extra)).expect("solver");
     let scale = (2.0 * G / A).sqrt();
     let mut out = vec![(0.0, front(fluid.as_ref(), dx) / A)];
     while fluid.state().t * scale < T_MAX + 0.1 {
