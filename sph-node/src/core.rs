@@ -102,7 +102,7 @@ impl SphCore {
 
     /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene. The tag and version are
     /// read first (another version is refused, naming both); what the bytes hold is then checked before it is used
-    /// ([`FluidSolver::restore`], [`crate::restore`]); a state that does not hold together is refused naming the
+    /// ([`FluidSolver::restore`], `restore.rs`); a state that does not hold together is refused naming the
     /// field, and the core keeps the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), SphError> {
         let invalid = |message: String| SphError::InvalidParameter {

@@ -1,5 +1,5 @@
 //! The weakly compressible SPH solver (`DESIGN.md` §4.2; Long et al. 2016, Eqs. (9)–(12)): [`WcsphSolver`] and its
-//! step ([`solver`]), its parameters ([`params`]), its cell-sorted working copy of the particles ([`sorted`]), and its
+//! step ([`solver`]), its parameters ([`params`]), its cell-sorted working copy of the particles (`sorted.rs`), and its
 //! rate equations, one file each, with the optional δ-SPH density diffusion (Molteni & Colagrossi 2009, Fourtakas et
 //! al. 2019).
 

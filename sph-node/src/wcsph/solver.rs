@@ -3,17 +3,18 @@
 //! ([`crate::wcsph::density_diffusion`]), advanced by kick–drift–kick.
 //!
 //! The solver owns the serializable [`FluidState`] and [`WallParticles`], a working copy of the particles sorted by
-//! cell, and scratch that is rebuilt every step (cell bins, neighbour lists with the ∇W factor of each pair,
-//! rates).
+//! cell (`wcsph/sorted.rs`), and scratch that is rebuilt every step (cell bins, neighbour lists with the ∇W
+//! factor of each pair, rates) and never saved (`solver/restore.rs`). The step is [`WcsphSolver::step`] below; its passes
+//! over the sorted particles are in `solver/passes.rs`.
 //!
 //! Speed (`docs/PERFORMANCE.md`): the fluid is re-sorted by cell at every neighbour search, so that the gathers read
 //! neighbouring memory; the neighbour lists are built once per search (fluid particles only: walls get their
 //! pressure straight from the cell bins) with the ∇W factor of every pair, and reused by every pass until the next
 //! search (r² and W, where a pass needs them, are recomputed from the positions, which the lists were built from:
 //! 12 bytes per pair instead of 28). Every sum still runs over the same neighbours in the same order, with the
-//! same arithmetic, as the plain gathers of [`continuity`], [`momentum`], [`adami`] and
-//! [`crate::corrections::xsph`] on the id-ordered particles, so the results are bit-identical to theirs (tests
-//! below) and independent of the thread count.
+//! same arithmetic, as plain gathers of [`crate::wcsph::continuity`], [`crate::wcsph::momentum`],
+//! [`crate::boundary::adami`] and [`crate::corrections::xsph`] on the id-ordered particles, so the results are
+//! bit-identical to theirs (`tests.rs`) and independent of the thread count.
 //!
 //! One search per step: the APD shift (§4.4) is computed at xⁿ with the lists of the last search and applied with
 //! the drift, x^{n+1} = xⁿ + Δt (v^{n+½} + XSPH) + δr (as DualSPHysics applies its shifting with the position
