@@ -17,8 +17,7 @@ use std::time::Duration;
 use common::*;
 use contact_broker::checkpoint::BrokerState;
 use cosim_proto::messages::Correction;
-use sph_node::core::Fluid;
-use sph_node::stability::EnergyGuard;
+use sph_node::core::SphCheckpoint;
 
 /// Bound on every run; no test may hang.
 const LIMIT: Duration = Duration::from_secs(120);
@@ -216,16 +215,12 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
     // sph.bin with one velocity more than there are particles: the fluid node refuses it when it starts, reports it
     // on its error topic, and the run fails with that reason (exit 1, summary.json `failed`).
     let bad = copy_of(&ck, &dir.join("sph-length"));
-    type SavedFluid = (String, u32, Fluid, EnergyGuard);
-    let (tag, version, mut fluid, guard): SavedFluid =
+    type SavedFluid = (String, u32, SphCheckpoint);
+    let (tag, version, mut fluid): SavedFluid =
         bincode::deserialize(&std::fs::read(ck.join("sph.bin")).unwrap()).unwrap();
-    let n = fluid.state().len();
-    fluid.state_mut().v.push([0.0; 2]);
-    rewrite(
-        &bad,
-        "sph.bin",
-        &bincode::serialize(&(tag, version, &fluid, &guard)).unwrap(),
-    );
+    let n = fluid.solver.state.len();
+    fluid.solver.state.v.push([0.0; 2]);
+    rewrite(&bad, "sph.bin", &bincode::serialize(&(tag, version, &fluid)).unwrap());
     let why = format!(
         "checkpoint: state.v holds {} entries, there are {n} fluid particles",
         n + 1

@@ -256,7 +256,7 @@ fn fingerprint() {
 
 /// A drop without walls in a central force field (as the oscillating-drop test, coarser).
 fn drop_solver() -> WcsphSolver {
-    use sph_node::solver::{SphParams, WcsphOptions};
+    use sph_node::{SphParams, WcsphParams};
     let dx = 1.0 / 20.0;
     let mut x = Vec::new();
     for iy in -20i64..20 {
@@ -271,11 +271,8 @@ fn drop_solver() -> WcsphSolver {
         rho0: 1000.0,
         dx,
         h: 1.3 * dx,
-        c0: 15.0,
         nu: 0.0,
         gravity: [0.0, 0.0],
-        alpha: 0.01,
-        shepard_interval: Some(7),
         xsph: 0.3,
         domain: cosim_proto::scene::BoxSpec {
             min: [-4.0, -4.0],
@@ -293,7 +290,10 @@ fn drop_solver() -> WcsphSolver {
         p,
         x,
     };
-    let options = WcsphOptions {
+    let options = WcsphParams {
+        c0: 15.0,
+        alpha: 0.01,
+        shepard_interval: Some(7),
         central_force: 1.0,
         ..Default::default()
     };

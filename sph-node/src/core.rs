@@ -4,114 +4,52 @@
 
 use std::time::Instant;
 
-use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
-use cosim_proto::scene::Scene;
-
 use bincode::Options;
-use cosim_proto::scene::{FluidSolver, PpeSourceKind};
+use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
+use cosim_proto::scene::{FluidSolver as SceneSolver, PpeSourceKind, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SphError;
+use crate::fluid_solver::{FluidSolver, SavedSolver};
 use crate::isph::{IsphSolver, PpeSource};
-use crate::particles::{FluidState, WallParticles};
-use crate::solver::{SphParams, WcsphSolver};
+use crate::setup;
 use crate::stability::EnergyGuard;
+use crate::wcsph::WcsphSolver;
 
 /// Tag and format version at the head of a fluid node's checkpoint (`docs/PROTOCOL.md` §9). Version 2: the
 /// solvers carry `fluid.cfl`; 3: the WCSPH solver carries its wall boxes and wall-guard count; 4: the neighbour lists
 /// keep only the ∇W factor per pair (no r², no W), and the WCSPH scratch has two per-particle buffers (was six); 6: the
-/// WCSPH options carry the δ-SPH density diffusion.
-const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 6);
+/// WCSPH options carry the δ-SPH density diffusion; 7: state only ([`SphCheckpoint`]: no parameters, neighbour lists
+/// or scratch, which the scene and the restore rebuild).
+pub const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 7);
 
-/// The fluid solver the scene asks for.
-#[derive(Serialize, Deserialize)]
-pub enum Fluid {
-    /// Weakly compressible.
-    Wcsph(WcsphSolver),
-    /// Incompressible (projection).
-    Isph(IsphSolver),
+/// What a fluid node's checkpoint holds after its tag and version: the solver's state and the energy guard's bound.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphCheckpoint {
+    /// The solver's state ([`FluidSolver::save`]).
+    pub solver: SavedSolver,
+    /// The energy guard.
+    pub guard: EnergyGuard,
 }
 
-impl Fluid {
-    /// Build the solver of `fluid.solver`.
-    pub fn new(scene: &Scene) -> Result<Self, SphError> {
-        let spec = scene.fluid.as_ref().ok_or_else(|| SphError::InvalidScene {
-            key: "fluid".into(),
-            message: "the scene has no [fluid] section".into(),
-        })?;
-        Ok(match spec.solver {
-            FluidSolver::Wcsph => Fluid::Wcsph(WcsphSolver::new(scene)?),
-            FluidSolver::Isph => Fluid::Isph(IsphSolver::with_source(
-                scene,
-                match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
-                    PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
-                    PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
-                },
-            )?),
-        })
-    }
-
-    /// Particle state.
-    pub fn state(&self) -> &FluidState {
-        match self {
-            Fluid::Wcsph(s) => s.state(),
-            Fluid::Isph(s) => s.state(),
-        }
-    }
-
-    /// Particle state, for corrections.
-    pub fn state_mut(&mut self) -> &mut FluidState {
-        match self {
-            Fluid::Wcsph(s) => s.state_mut(),
-            Fluid::Isph(s) => s.state_mut(),
-        }
-    }
-
-    /// Wall particles.
-    pub fn walls(&self) -> &WallParticles {
-        match self {
-            Fluid::Wcsph(s) => s.walls(),
-            Fluid::Isph(s) => s.walls(),
-        }
-    }
-
-    /// Resolved parameters.
-    pub fn params(&self) -> &SphParams {
-        match self {
-            Fluid::Wcsph(s) => s.params(),
-            Fluid::Isph(s) => s.params(),
-        }
-    }
-
-    /// Stable step of the current state.
-    pub fn stable_dt(&self) -> f64 {
-        match self {
-            Fluid::Wcsph(s) => s.stable_dt(),
-            Fluid::Isph(s) => s.stable_dt(),
-        }
-    }
-
-    /// Fluid particles the WCSPH wall guard has put back out of a wall over the run
-    /// ([`WcsphSolver::wall_pushes`]); `None` for ISPH (its guard's count is per step, in its PPE report).
-    pub fn wall_pushes(&self) -> Option<u64> {
-        match self {
-            Fluid::Wcsph(s) => Some(s.wall_pushes().0),
-            Fluid::Isph(_) => None,
-        }
-    }
-
-    /// One step.
-    pub fn step(&mut self, dt: f64) -> Result<(), SphError> {
-        match self {
-            Fluid::Wcsph(s) => s.step(dt),
-            Fluid::Isph(s) => s.step(dt),
-        }
-    }
+/// The solver of `fluid.solver`.
+pub fn solver_from_scene(scene: &Scene) -> Result<Box<dyn FluidSolver>, SphError> {
+    let spec = setup::fluid_spec_any(scene)?;
+    Ok(match spec.solver {
+        SceneSolver::Wcsph => Box::new(WcsphSolver::new(scene)?),
+        SceneSolver::Isph => Box::new(IsphSolver::with_source(
+            scene,
+            match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
+                PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
+                PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
+            },
+        )?),
+    })
 }
 
 /// A fluid node: the solver plus what it tells the broker.
 pub struct SphCore {
-    solver: Fluid,
+    solver: Box<dyn FluidSolver>,
     setup: SphSetup,
     guard: EnergyGuard,
     /// `coupling.max_dt`: no command may ask for a longer step.
@@ -121,7 +59,7 @@ pub struct SphCore {
 impl SphCore {
     /// Fill the scene's fluid blocks and walls with particles.
     pub fn new(scene: &Scene) -> Result<Self, SphError> {
-        let solver = Fluid::new(scene)?;
+        let solver = solver_from_scene(scene)?;
         let params = solver.params();
         let setup = SphSetup {
             particles: solver.state().len() as u32,
@@ -146,58 +84,63 @@ impl SphCore {
     }
 
     /// The solver (tests, checkpoints).
-    pub fn solver(&self) -> &Fluid {
-        &self.solver
+    pub fn solver(&self) -> &dyn FluidSolver {
+        self.solver.as_ref()
     }
 
-    /// The node's state between two steps, for a checkpoint: the whole solver — particles, and also their order
-    /// in memory, the neighbour lists and every cache a step reads before it rebuilds them, so that a restarted
-    /// run computes the same bits — and the energy guard's bound.
+    /// The node's state between two steps, for a checkpoint: the solver's ([`FluidSolver::save`]: particles,
+    /// walls and what the method carries from one step to the next) and the energy guard's bound. Parameters come from
+    /// the scene; neighbour lists, cell order and scratch are rebuilt on restore.
     pub fn checkpoint(&self) -> Vec<u8> {
         let tag = CHECKPOINT_TAG;
-        bincode::serialize(&(tag.0, tag.1, &self.solver, &self.guard))
-            .expect("in-memory bincode encoding of plain data")
+        let saved = SphCheckpoint {
+            solver: self.solver.save(),
+            guard: self.guard,
+        };
+        bincode::serialize(&(tag.0, tag.1, &saved)).expect("in-memory bincode encoding of plain data")
     }
 
-    /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene. What the bytes hold is
-    /// checked before it is used ([`crate::restore`]): against the solver this core built from the scene, and for
-    /// consistency with itself; a state that does not hold together is refused naming the field, and the core
-    /// keeps the scene's state.
+    /// Continue from [`SphCore::checkpoint`]'s bytes, on a core built from the same scene. The tag and version are
+    /// read first (another version is refused, naming both); what the bytes hold is then checked before it is used
+    /// ([`FluidSolver::restore`], `restore.rs`); a state that does not hold together is refused naming the
+    /// field, and the core keeps the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), SphError> {
         let invalid = |message: String| SphError::InvalidParameter {
             name: "checkpoint",
             message,
         };
-        let (tag, version, solver, guard): (String, u32, Fluid, EnergyGuard) = bincode::DefaultOptions::new()
-            .with_fixint_encoding()
-            .reject_trailing_bytes()
-            .deserialize(data)
-            .map_err(|e| invalid(format!("not a fluid node's state: {e}")))?;
+        let not_ours = |e: bincode::Error| invalid(format!("not a fluid node's state: {e}"));
+        let options = bincode::DefaultOptions::new().with_fixint_encoding();
+        let (tag, version): (String, u32) = options.allow_trailing_bytes().deserialize(data).map_err(not_ours)?;
         if (tag.as_str(), version) != CHECKPOINT_TAG {
             return Err(invalid(format!(
-                "holds `{tag}` version {version}, this sph-node reads `{}` version {}",
+                "holds `{tag}` version {version}, this sph-node reads `{}` version {} (restart the run from its start)",
                 CHECKPOINT_TAG.0, CHECKPOINT_TAG.1
             )));
         }
-        let (saved, scene) = (solver.state().len(), self.solver.state().len());
-        if saved != scene || solver.walls().len() != self.solver.walls().len() {
+        let (_, _, saved): (String, u32, SphCheckpoint) =
+            options.reject_trailing_bytes().deserialize(data).map_err(not_ours)?;
+        let SphCheckpoint { solver, guard } = saved;
+        if solver.solver != self.solver.name() {
+            return Err(invalid(format!(
+                "saved with fluid.solver = \"{}\", the scene has \"{}\"",
+                solver.solver,
+                self.solver.name()
+            )));
+        }
+        let (saved, scene) = (solver.state.len(), self.solver.state().len());
+        if saved != scene || solver.walls.len() != self.solver.walls().len() {
             return Err(invalid(format!(
                 "holds {saved} fluid particles, the scene makes {scene} (another scene?)"
             )));
         }
-        match (&solver, &self.solver) {
-            (Fluid::Wcsph(saved), Fluid::Wcsph(scene)) => saved.check_restored(scene),
-            (Fluid::Isph(saved), Fluid::Isph(scene)) => saved.check_restored(scene),
-            _ => Err("saved with the other fluid.solver".into()),
-        }
-        .map_err(invalid)?;
         if guard != self.guard {
             return Err(invalid(format!(
                 "guard.bound = {} where the scene gives {}",
                 guard.bound, self.guard.bound
             )));
         }
-        self.solver = solver;
+        self.solver.restore(solver).map_err(invalid)?;
         self.guard = guard;
         Ok(())
     }

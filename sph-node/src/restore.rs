@@ -1,18 +1,20 @@
 //! Checks on a fluid solver read back from a checkpoint (`docs/PROTOCOL.md` §9), before the node continues from it.
 //!
-//! A checkpoint holds the whole solver, caches included, so that the continued run computes the same bits. The
-//! folder's checksums catch a damaged copy; these checks catch a state that is intact but does not hold together,
-//! from another tool or a build with a bug, which would otherwise panic on an index or run on silently wrong:
-//! - what follows from the scene (parameters, kernel, walls, masses, particle count) equals what the scene gives;
+//! A checkpoint holds the solver's state only ([`crate::fluid_solver::SavedSolver`]): parameters come from the scene,
+//! and what a step rebuilds (cell order, cell bins, neighbour lists, scratch) is rebuilt on restore as the step
+//! rebuilds it, so the continued run computes the same bits. The folder's checksums catch a damaged copy; these
+//! checks catch a state that is intact but does not hold together, from another tool or a build with a bug, which
+//! would otherwise panic on an index or run on silently wrong:
+//! - what follows from the scene (walls, masses, particle count) equals what the scene gives;
 //! - every per-particle array has one entry per particle, and the numbers a step starts from are finite;
-//! - id maps are permutations, and copies of the state agree with it bit for bit;
-//! - the caches built from the positions (cell order, cell bins, neighbour lists) are those the positions give:
-//!   they are built again and compared.
+//! - every position lies in the fluid's domain (the cell grid of the rebuilt caches must fit in memory).
 //!
-//! Each solver checks its own fields ([`crate::WcsphSolver`], [`crate::IsphSolver`]) with the helpers here. A
+//! Each solver checks its own part ([`crate::WcsphSolver`], [`crate::IsphSolver`]) with the helpers here. A
 //! refusal is one line naming the field, the index and the value.
 
 use std::fmt::Debug;
+
+use cosim_proto::scene::BoxSpec;
 
 use crate::particles::{FluidState, WallParticles};
 
@@ -41,15 +43,6 @@ pub(crate) fn finite2(field: &str, values: &[[f64; 2]]) -> Check {
     match values.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
         None => Ok(()),
         Some(k) => Err(format!("{field}[{k}] = {:?} is not finite", values[k])),
-    }
-}
-
-/// `saved` equals what the scene gives (`scene`).
-pub(crate) fn same<T: PartialEq + Debug>(field: &str, saved: &T, scene: &T) -> Check {
-    if saved == scene {
-        Ok(())
-    } else {
-        Err(format!("{field} = {saved:?} where the scene gives {scene:?}"))
     }
 }
 
@@ -86,19 +79,12 @@ impl Bits for [f64; 2] {
     }
 }
 
-/// `ids` (slot → id) and `slot` (id → slot) are inverse permutations of `0..n`.
-pub(crate) fn permutation(ids_field: &str, ids: &[u32], slot_field: &str, slot: &[u32], n: usize) -> Check {
-    len(ids_field, ids, n, "fluid particles")?;
-    len(slot_field, slot, n, "fluid particles")?;
-    for (id, &k) in slot.iter().enumerate() {
-        match ids.get(k as usize) {
-            Some(&back) if back as usize == id => {}
-            Some(&back) => return Err(format!("{slot_field}[{id}] = {k} but {ids_field}[{k}] = {back}")),
-            None => return Err(format!("{slot_field}[{id}] = {k} is not a slot ({n} fluid particles)")),
-        }
+/// Every position of `x` (field `field`) lies in `domain`.
+pub(crate) fn inside(field: &str, x: &[[f64; 2]], domain: &BoxSpec) -> Check {
+    match x.iter().position(|p| !domain.contains(*p)) {
+        None => Ok(()),
+        Some(i) => Err(format!("{field}[{i}] = {:?} is outside the fluid's domain", x[i])),
     }
-    // `slot` maps 0..n into 0..n one to one (each slot sends its id back), so `ids` is its inverse.
-    Ok(())
 }
 
 /// The fluid particles: as many as the scene makes, their masses the scene's (a particle's mass never changes),
@@ -173,23 +159,6 @@ max = [0.43, 0.3]
         );
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         cosim_proto::scene::parse("tank.toml", &text, &sets).expect("a valid scene")
-    }
-
-    #[test]
-    fn permutations_are_checked_both_ways() {
-        assert_eq!(permutation("ids", &[2, 0, 1], "slot", &[1, 2, 0], 3), Ok(()));
-        assert_eq!(
-            permutation("ids", &[2, 0, 1], "slot", &[1, 2, 7], 3),
-            Err("slot[2] = 7 is not a slot (3 fluid particles)".into())
-        );
-        assert_eq!(
-            permutation("ids", &[2, 0, 0], "slot", &[1, 2, 0], 3),
-            Err("slot[1] = 2 but ids[2] = 0".into())
-        );
-        assert_eq!(
-            permutation("ids", &[0, 1], "slot", &[0, 1, 2], 3),
-            Err("ids holds 2 entries, there are 3 fluid particles".into())
-        );
     }
 
     #[test]

@@ -5,7 +5,7 @@
 mod common;
 
 use sph_node::kernel::CubicSpline;
-use sph_node::solver::SphParams;
+use sph_node::SphParams;
 use sph_node::{FluidState, IsphSolver, WallParticles, WcsphSolver};
 
 /// What the disorder metrics read, from either solver.

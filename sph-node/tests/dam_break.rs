@@ -16,7 +16,8 @@
 
 mod common;
 
-use sph_node::core::Fluid;
+use sph_node::core::solver_from_scene;
+use sph_node::FluidSolver;
 
 const A: f64 = 0.1;
 const G: f64 = 9.81;
@@ -81,7 +82,7 @@ fn release_offset() -> f64 {
 }
 
 /// Surge front: the rightmost fluid particle near the floor, plus half a spacing (so Z(0) = 1).
-fn front(fluid: &Fluid, dx: f64) -> f64 {
+fn front(fluid: &dyn FluidSolver, dx: f64) -> f64 {
     let s = fluid.state();
     s.x.iter()
         .filter(|x| x[1] < 0.25 * A)
@@ -93,13 +94,13 @@ fn front(fluid: &Fluid, dx: f64) -> f64 {
 /// Runs to T = 2.6 at Δx = a/40 and returns (T, Z) every step.
 fn surge(extra: &str) -> Vec<(f64, f64)> {
     let dx = A / 40.0;
-    let mut fluid = Fluid::new(&common::dam_break(A, 5.0 * A, dx, extra)).expect("solver");
+    let mut fluid = solver_from_scene(&common::dam_break(A, 5.0 * A, dx, extra)).expect("solver");
     let scale = (2.0 * G / A).sqrt();
-    let mut out = vec![(0.0, front(&fluid, dx) / A)];
+    let mut out = vec![(0.0, front(fluid.as_ref(), dx) / A)];
     while fluid.state().t * scale < T_MAX + 0.1 {
         let dt = fluid.stable_dt();
         fluid.step(dt).expect("stable");
-        out.push((fluid.state().t * scale, front(&fluid, dx) / A));
+        out.push((fluid.state().t * scale, front(fluid.as_ref(), dx) / A));
     }
     out
 }

@@ -161,7 +161,7 @@ fn still_tank(extra: &str, plain: bool, t_from: f64, t_end: f64) -> (Vec<f64>, f
     let scene = common::still_water(WIDTH, DEPTH, DX, extra);
     let mut solver = WcsphSolver::new(&scene).expect("solver");
     if plain {
-        let delta = solver.options().density_diffusion;
+        let delta = solver.wcsph_params().density_diffusion;
         solver.set_density_diffusion(delta, false);
     }
     let start = solver.state().x.clone();
@@ -245,7 +245,7 @@ fn the_option_is_validated_with_the_scene() {
     assert_eq!(fluid.density_diffusion, 0.0);
     let on = parse(&["fluid.density_diffusion=0.1"]).expect("valid");
     assert_eq!(on.fluid.as_ref().unwrap().density_diffusion, 0.1);
-    assert_eq!(WcsphSolver::new(&on).unwrap().options().density_diffusion, 0.1);
+    assert_eq!(WcsphSolver::new(&on).unwrap().wcsph_params().density_diffusion, 0.1);
     for (sets, words) in [
         (
             &["fluid.density_diffusion=1.5"][..],
@@ -272,7 +272,7 @@ fn the_option_is_validated_with_the_scene() {
 /// against off, changes ρ by Δt D_i (the gather of the unit tests above), sign and factor included.
 #[test]
 fn the_solver_adds_the_term_to_the_continuity_rate() {
-    use sph_node::solver::{SphParams, WcsphOptions};
+    use sph_node::{SphParams, WcsphParams};
     let (n, dx) = (10, 0.01);
     let (h, c0) = (1.3 * dx, 20.0);
     let x = lattice(n, n, dx);
@@ -284,11 +284,8 @@ fn the_solver_adds_the_term_to_the_continuity_rate() {
         rho0: RHO0,
         dx,
         h,
-        c0,
         nu: 0.0,
         gravity: [0.0, -G],
-        alpha: 0.0,
-        shepard_interval: None,
         xsph: 0.0,
         domain: cosim_proto::scene::BoxSpec {
             min: [-1.0, -1.0],
@@ -309,7 +306,16 @@ fn the_solver_adds_the_term_to_the_continuity_rate() {
     let dt = 1e-8;
     let stepped = |delta: f64| {
         let walls = sph_node::WallParticles::default();
-        let mut s = WcsphSolver::from_particles(params.clone(), WcsphOptions::default(), state.clone(), walls).unwrap();
+        let mut s = WcsphSolver::from_particles(
+            params.clone(),
+            WcsphParams {
+                c0,
+                ..WcsphParams::default()
+            },
+            state.clone(),
+            walls,
+        )
+        .unwrap();
         s.set_density_diffusion(delta, true);
         s.step(dt).unwrap();
         s.state().rho.clone()

@@ -7,8 +7,8 @@
 //! The drop is built programmatically ([`WcsphSolver::from_particles`]) because scenes fill rectangles only.
 
 use cosim_proto::scene::BoxSpec;
-use sph_node::solver::{SphParams, WcsphOptions};
 use sph_node::{FluidState, WallParticles, WcsphSolver};
+use sph_node::{SphParams, WcsphParams};
 
 const R: f64 = 1.0;
 const SIGMA0: f64 = 0.5;
@@ -28,7 +28,7 @@ fn exact() -> Vec<(f64, f64)> {
         .collect()
 }
 
-fn drop_solver(n_radius: usize, c0: f64, options: WcsphOptions, shepard: Option<u32>, xsph: f64) -> WcsphSolver {
+fn drop_solver(n_radius: usize, c0: f64, options: WcsphParams, shepard: Option<u32>, xsph: f64) -> WcsphSolver {
     let dx = R / n_radius as f64;
     let n = n_radius as i64;
     let mut x = Vec::new();
@@ -44,11 +44,8 @@ fn drop_solver(n_radius: usize, c0: f64, options: WcsphOptions, shepard: Option<
         rho0: RHO0,
         dx,
         h: 1.3 * dx,
-        c0,
         nu: 0.0,
         gravity: [0.0, 0.0],
-        alpha: 0.01,
-        shepard_interval: shepard,
         xsph,
         domain: BoxSpec {
             min: [-4.0 * R, -4.0 * R],
@@ -71,7 +68,10 @@ fn drop_solver(n_radius: usize, c0: f64, options: WcsphOptions, shepard: Option<
         p,
         x,
     };
-    let options = WcsphOptions {
+    let options = WcsphParams {
+        c0,
+        alpha: 0.01,
+        shepard_interval: shepard,
         central_force: OMEGA * OMEGA,
         ..options
     };
@@ -85,7 +85,7 @@ fn second_moment(s: &FluidState) -> f64 {
 }
 
 /// Runs the drop and returns (period, A_max, t(A_max), worst |A − A_exact| on the 0.1 grid up to 4.6).
-fn run(n_radius: usize, c0: f64, options: WcsphOptions, shepard: Option<u32>, xsph: f64) -> (f64, f64, f64, f64) {
+fn run(n_radius: usize, c0: f64, options: WcsphParams, shepard: Option<u32>, xsph: f64) -> (f64, f64, f64, f64) {
     let mut solver = drop_solver(n_radius, c0, options, shepard, xsph);
     let m0 = second_moment(solver.state());
     let a_of = |s: &WcsphSolver| R * (second_moment(s.state()) / m0).sqrt();
@@ -130,7 +130,7 @@ fn run(n_radius: usize, c0: f64, options: WcsphOptions, shepard: Option<u32>, xs
 
 #[test]
 fn oscillating_drop_period() {
-    let options = WcsphOptions {
+    let options = WcsphParams {
         mls: false,
         apd: 0.04,
         central_force: 0.0,

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use sph_node::isph::wall_guard::WallBoxes;
+use sph_node::boundary::wall_guard::WallBoxes;
 use sph_node::WcsphSolver;
 
 const T_END: f64 = 2.5;

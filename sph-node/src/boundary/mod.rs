@@ -2,4 +2,5 @@
 
 pub mod adami;
 pub mod repulsion;
+pub mod wall_guard;
 pub mod walls;

@@ -25,7 +25,7 @@
 
 use rayon::prelude::*;
 
-use crate::isph::wall_guard::WallBoxes;
+use crate::boundary::wall_guard::WallBoxes;
 
 /// Range d0 of the repulsion, in units of Δx: a quarter spacing from the face (the first wall layer is Δx/2
 /// behind it, so the zone begins 3Δx/4 from the nearest wall particle).

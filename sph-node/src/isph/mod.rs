@@ -7,7 +7,7 @@
 //! * [`bicgstab`]: BiCGSTAB with Jacobi preconditioning and fixed-order (thread-count independent) reductions.
 //! * [`contact`]: the particles against a structure the fluid does not see (coupled runs): Neumann rows, not a free
 //!   surface.
-//! * [`wall_guard`]: a particle found inside a wall is put back on its face.
+//! * [`crate::boundary::wall_guard`]: a particle found inside a wall is put back on its face.
 //! * [`wall_normal`]: the projection's wall condition u^{n+1} · n = 0 in the wall rows and the walls' velocity in
 //!   ∇·u*.
 //! * [`solver`]: [`IsphSolver`], with the public API of [`crate::WcsphSolver`].
@@ -31,7 +31,6 @@ pub mod ppe;
 pub mod projection;
 pub mod solver;
 pub mod sparse;
-pub mod wall_guard;
 pub mod wall_normal;
 
 pub use solver::IsphSolver;

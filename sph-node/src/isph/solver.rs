@@ -3,7 +3,7 @@
 //!
 //! One step of size Δt:
 //! 0. in a coupled run, the contact's corrections since the last step tell which particles lean on a structure
-//!    ([`super::contact`]), and a particle found inside a wall is put back on its face ([`super::wall_guard`]);
+//!    ([`super::contact`]), and a particle found inside a wall is put back on its face ([`crate::boundary::wall_guard`]);
 //! 1. predictor u* = uⁿ + Δt (g + ν∇²uⁿ), x* = xⁿ + Δt u*;
 //! 2. neighbours at x*; free surface (∇·r < 1.5 → p = 0); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
 //! 3. PPE solved by Jacobi-BiCGSTAB warm-started from the last pressures (fluid and walls);
@@ -12,28 +12,32 @@
 //!
 //! The fluid is incompressible: ρ = ρ0 for fluid and walls throughout.
 
-use cosim_proto::scene::{BoxSpec, FluidSolver, Scene};
+use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::contact::{self, ContactLayer, ContactRow};
-use super::wall_guard::WallBoxes;
-use super::{bicgstab, free_surface, ppe, projection, wall_normal, IsphOptions, PpeSource};
+use super::contact::{ContactLayer, ContactRow};
+use super::{bicgstab, ppe, projection, wall_normal, IsphOptions, PpeSource};
 use crate::boundary::repulsion::RANGE;
-use crate::boundary::walls;
+use crate::boundary::wall_guard::WallBoxes;
 use crate::corrections::{apd, xsph};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::kernel::CubicSpline;
 use crate::neighbors::{CellList, NeighborList};
+use crate::params::SphParams;
 use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
-use crate::setup;
-use crate::solver::SphParams;
+use crate::setup::{self, FluidSetup};
 
+mod diagnostics;
+mod fluid_solver;
 mod restore;
+mod source;
+
+use source::Source;
 
 /// Scratch rebuilt every step: nothing here is state.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default)]
 struct Scratch {
     x: Vec<[f64; 2]>,
     v: Vec<[f64; 2]>,
@@ -48,11 +52,8 @@ struct Scratch {
     source: Vec<f64>,
     xsph: Vec<[f64; 2]>,
     wall_v: Vec<[f64; 2]>,
-    /// The PPE's matrix and right-hand side, assembled anew each step into the allocations of the last (not
-    /// saved: a checkpoint's format does not change).
-    #[serde(skip)]
+    /// The PPE's matrix and right-hand side, assembled anew each step into the allocations of the last.
     ppe: ppe::SparseRows,
-    #[serde(skip)]
     rhs: Vec<f64>,
 }
 
@@ -76,7 +77,7 @@ pub struct PpeReport {
 }
 
 /// Incompressible SPH solver (projection method).
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug)]
 pub struct IsphSolver {
     params: SphParams,
     options: IsphOptions,
@@ -95,7 +96,7 @@ pub struct IsphSolver {
     /// The particles the contact corrected lately and the faces they revealed (coupled runs; see
     /// [`super::contact`]).
     contact: ContactLayer,
-    /// The wall boxes, to put back a particle found inside a wall (see [`super::wall_guard`]).
+    /// The wall boxes, to put back a particle found inside a wall (see [`crate::boundary::wall_guard`]).
     wall_boxes: WallBoxes,
     /// The unit normal of each wall particle ([`super::wall_normal`]).
     wall_normals: Vec<[f64; 2]>,
@@ -125,16 +126,7 @@ impl IsphSolver {
 
     /// As [`IsphSolver::new`] with all the ISPH options.
     pub fn with_options(scene: &Scene, options: IsphOptions) -> Result<Self> {
-        let spec = scene.fluid.as_ref().ok_or_else(|| SphError::InvalidScene {
-            key: "fluid".into(),
-            message: "the scene has no [fluid] section".into(),
-        })?;
-        if spec.solver != FluidSolver::Isph {
-            return Err(SphError::InvalidScene {
-                key: "fluid.solver".into(),
-                message: "IsphSolver needs fluid.solver = \"isph\"".into(),
-            });
-        }
+        let spec = setup::fluid_spec(scene, SceneSolver::Isph)?;
         if !(options.tolerance > 0.0 && options.max_iterations > 0 && options.courant > 0.0) {
             return Err(SphError::InvalidParameter {
                 name: "isph options",
@@ -142,42 +134,13 @@ impl IsphSolver {
             });
         }
         let gravity = scene.run.gravity;
-        let dx = spec.spacing;
-        let h = spec.smoothing_ratio * dx;
-        let rho0 = spec.density;
-        // Hydrostatic initial pressure (the warm start of the first PPE); the Tait law only places densities,
-        // which are reset to ρ0.
-        let mut state = setup::initial_state(spec, gravity, &Tait::new(rho0, 1.0));
-        state.rho.iter_mut().for_each(|r| *r = rho0);
-
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for b in spec.blocks.iter().chain(&scene.walls) {
-            for k in 0..2 {
-                lo[k] = lo[k].min(b.min[k]);
-                hi[k] = hi[k].max(b.max[k]);
-            }
-        }
-        let fluid_centre = {
-            let n = state.len().max(1) as f64;
-            let s = state.x.iter().fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]]);
-            [s[0] / n, s[1] / n]
-        };
-        let wall_x = walls::wall_positions(&scene.walls, spec.blocks[0].min, dx, h, fluid_centre);
-        let wall_boxes = WallBoxes::new(&scene.walls, dx, h, fluid_centre);
-        let wall_normals = wall_normal::wall_normals(&wall_x, &wall_boxes);
-        let nw = wall_x.len();
-        let walls = WallParticles {
-            x: wall_x,
-            p: vec![0.0; nw],
-            rho: vec![rho0; nw],
-            m: vec![rho0 * dx * dx; nw],
-        };
-        // Domain: as WcsphSolver, the box around blocks and walls padded by half its largest extent, and at least by
-        // how far a particle that leaves the walls can travel in the run: the end of a floor it flows off, a jet
-        // thrown up by an impact on a structure. ISPH fronts and jets move at the fluid's full speed (the elastic
-        // gate's front runs at 2.1 m/s, ≈ 2 sqrt(g H), and falls off the floor's end at x = 0.5 m at t = 0.24 s;
-        // the obstacle throws a particle up at 4 m/s), so the padding is 2 sqrt(2 |g| H) T + |g| T²/2 for a run of
-        // T = end_time. This box only catches runaway particles; it bounds no search grid.
+        let (dx, rho0) = (spec.spacing, spec.density);
+        // The domain (see `FluidSetup::new`) is padded at least by how far a particle that leaves the walls can
+        // travel in the run: the end of a floor it flows off, a jet thrown up by an impact on a structure. ISPH fronts
+        // and jets move at the fluid's full speed (the elastic gate's front runs at 2.1 m/s, ≈ 2 sqrt(g H), and falls
+        // off the floor's end at x = 0.5 m at t = 0.24 s; the obstacle throws a particle up at 4 m/s), so the padding
+        // is 2 sqrt(2 |g| H) T + |g| T²/2 for a run of T = end_time. This box only catches runaway particles; it
+        // bounds no search grid.
         let g_abs = gravity[0].hypot(gravity[1]);
         let v_fluid = {
             let (top, bottom) = setup::fluid_extent(spec);
@@ -185,23 +148,18 @@ impl IsphSolver {
         };
         let t_end = scene.run.end_time.max(0.0);
         let reach = 2.0 * v_fluid * t_end + 0.5 * g_abs * t_end * t_end;
-        let pad = (0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 4.0 * h).max(reach);
-        let domain = BoxSpec {
-            min: [lo[0] - pad, lo[1] - pad],
-            max: [hi[0] + pad, hi[1] + pad],
-        };
-        let params = SphParams {
-            rho0,
-            dx,
-            h,
-            c0: 0.0, // no sound speed in ISPH
-            nu: spec.kinematic_viscosity,
-            gravity,
-            alpha: 0.0, // no artificial viscosity in ISPH
-            shepard_interval: None,
-            xsph: spec.xsph,
-            domain,
-        };
+        // Hydrostatic initial pressure (the warm start of the first PPE); the Tait law only places densities,
+        // which are reset to ρ0.
+        let FluidSetup {
+            mut state,
+            walls,
+            wall_boxes,
+            params,
+        } = FluidSetup::new(scene, spec, &Tait::new(rho0, 1.0), reach);
+        state.rho.iter_mut().for_each(|r| *r = rho0);
+        let wall_normals = wall_normal::wall_normals(&walls.x, &wall_boxes);
+        let nw = walls.len();
+        let h = params.h;
         let kernel = CubicSpline::new(h);
         let rho_ref = {
             let reach = (2.0 * h / dx).ceil() as i64 + 1;
@@ -270,63 +228,6 @@ impl IsphSolver {
         &self.walls
     }
 
-    /// Neighbour pairs of the current lists (ordered: each pair counts once for each of its particles), the wall
-    /// particles' lists included (their PPE rows need them).
-    pub fn pair_count(&self) -> usize {
-        self.scratch.list.pair_count()
-    }
-
-    /// Iterations, residual and free-surface count of the last PPE solve.
-    pub fn last_ppe(&self) -> PpeReport {
-        self.last_ppe
-    }
-
-    /// Δt = min(C h / max(v_max, sqrt(2 |g| H)), 0.25 sqrt(h/a_max), 0.125 h²/ν) (`DESIGN.md` §4.3, step 6, with
-    /// the force and viscous limits of §4.2; H is the initial fluid depth, a_max the largest acceleration of the
-    /// last step, at least |g|), times the scene's `fluid.cfl` (1 by default).
-    pub fn stable_dt(&self) -> f64 {
-        let h = self.params.h;
-        let v_max = self
-            .state
-            .v
-            .par_iter()
-            .map(|v| v[0].hypot(v[1]))
-            .reduce(|| 0.0, f64::max);
-        let v = v_max.max(self.v_ref);
-        let mut dt = f64::INFINITY;
-        if v > 0.0 {
-            dt = self.options.courant * h / v; // §4.3 step 6
-        }
-        if self.a_max > 0.0 {
-            dt = dt.min(0.25 * (h / self.a_max).sqrt()); // §4.2 force condition
-        }
-        if self.params.nu > 0.0 {
-            dt = dt.min(0.125 * h * h / self.params.nu); // §4.2 viscous condition
-        }
-        self.cfl
-            * if dt.is_finite() {
-                dt
-            } else {
-                0.25 * h // no motion, no force: any step; keep it finite
-            }
-    }
-
-    /// Σ ½ m |v|² (per unit depth).
-    pub fn kinetic_energy(&self) -> f64 {
-        self.state.kinetic_energy()
-    }
-
-    /// Σ −m g · x (per unit depth; zero at the origin).
-    pub fn potential_energy(&self) -> f64 {
-        self.state.potential_energy(self.params.gravity)
-    }
-
-    /// Shepard-normalised SPH interpolation of the fluid pressure at `point`; `None` when no fluid particle is
-    /// within 2h.
-    pub fn sample_pressure(&self, point: [f64; 2]) -> Option<f64> {
-        self.state.sample_pressure(&self.kernel, point)
-    }
-
     /// Advances the fluid by `dt` (predictor, PPE, corrector; see the module documentation).
     ///
     /// Errors: [`SphError::PpeNotConverged`] when BiCGSTAB does not reach the tolerance, [`SphError::Unstable`]
@@ -379,101 +280,13 @@ impl IsphSolver {
         self.rebuild_neighbors();
         self.scratch.v[..nf].copy_from_slice(&self.state.v);
 
-        // 2. Free surface and PPE source at x*.
-        let mut free = std::mem::take(&mut self.scratch.free);
-        free_surface::free_surface_into(
-            &self.view(),
-            &self.scratch.list,
-            &self.kernel,
-            self.options.free_surface_threshold,
-            &mut free,
-        );
-        // Particles against a structure (see `super::contact`): their support, ∇·r and ρ* count the structure's
-        // half-space; their rows carry the face's Neumann condition.
-        let mut rows = std::mem::take(&mut self.scratch.contact);
-        contact::contact_rows_into(
-            &self.view(),
-            &self.scratch.list,
-            &self.kernel,
-            &self.contact,
-            self.params.dx,
-            self.params.rho0,
-            self.options.free_surface_threshold,
-            &mut free,
-            &mut rows,
-        );
-        let mut in_contact = std::mem::take(&mut self.scratch.in_contact);
-        in_contact.clear();
-        in_contact.extend(rows.iter().map(Option::is_some));
-        let n_contact = in_contact.iter().filter(|&&c| c).count();
-        let mut source = std::mem::take(&mut self.scratch.source);
-        source.clear();
-        // Walls carry Δt g and the normal part of the fluid's motion next to them for the divergence only (see
-        // `projection::velocity_divergence` and `wall_normal`), and so does the normal velocity of the first layer
-        // against a structure, with the face's (see `contact::face_normal_velocity`).
-        let mut wall_v = std::mem::take(&mut self.scratch.wall_v);
-        wall_normal::divergence_velocities_into(
-            &self.view(),
-            &self.scratch.list,
-            &self.kernel,
-            &self.wall_normals,
-            dt,
-            g,
-            &mut wall_v,
-        );
-        self.scratch.v[nf..].copy_from_slice(&wall_v);
-        self.scratch.wall_v = wall_v;
-        for (v, row) in self.scratch.v[..nf].iter_mut().zip(&rows) {
-            if let Some(row) = row.filter(|r| r.against) {
-                *v = contact::face_normal_velocity(*v, &row.face, dt, g);
-            }
-        }
-        {
-            let view = self.view();
-            let (list, kernel) = (&self.scratch.list, &self.kernel);
-            let (rho0, rho_ref) = (self.params.rho0, self.rho_ref);
-            // Δt² of the density terms: Δt · max(Δt, Δt_own). They move a particle by a fixed fraction of its density
-            // error per step (Δx ∝ Δt² · source), so a step shorter than the solver's own (a coupled run steps at
-            // the coupling's max_dt, 1e-4 s where ISPH would take 1e-3 s) would relax the density that many times
-            // faster in time, and the ~1 % deficit the summation reads next to any truncated support (the second
-            // row under a free surface or over a structure) would become a sink of −γ 0.01 ρ0 Δx²/(4 Δt²) ≈ −3 kPa
-            // at 2e-4 s: a suction that, clipped, takes the hydrostatic pressure off the structure. At Δt = Δt_own
-            // (every uncoupled run) this is Δt², bit for bit.
-            let dt2 = dt * dt.max(dt_own);
-            // ρ* of a particle against a structure counts the structure's half-space as fluid.
-            let rows = &rows;
-            let rho_star = |i: usize| {
-                let s = match rows.get(i).copied().flatten() {
-                    Some(row) => row.density,
-                    None => projection::summation_density(i, &view, list.of(i), kernel),
-                };
-                s * rho0 / rho_ref
-            };
-            match self.options.source {
-                // Cummins & Rudman 1999, Eq. (15): ∇·(∇p/ρ) = ∇·u*/Δt
-                // + Asai et al. 2012, Eq. (25): γ (ρ0 − ρ*)/(ρ0 Δt²) when density_relaxation γ > 0
-                PpeSource::DivergenceFree => {
-                    let gamma = self.options.density_relaxation;
-                    (0..nf)
-                        .into_par_iter()
-                        .map(|i| {
-                            let div = projection::velocity_divergence(i, &view, list.of(i), kernel) / dt;
-                            if gamma > 0.0 {
-                                div + gamma * (rho0 - rho_star(i)) / (rho0 * dt2)
-                            } else {
-                                div
-                            }
-                        })
-                        .collect_into_vec(&mut source)
-                }
-                // Shao & Lo 2003, Eq. (14): ∇·(∇p/ρ) = (ρ0 − ρ*)/(ρ0 Δt²), ρ* by summation at x* relative to the
-                // full-lattice sum (ρ* = ρ0 on the initial lattice)
-                PpeSource::DensityInvariant => (0..nf)
-                    .into_par_iter()
-                    .map(|i| (rho0 - rho_star(i)) / (rho0 * dt2))
-                    .collect_into_vec(&mut source),
-            }
-        }
+        let Source {
+            mut free,
+            rows,
+            in_contact,
+            n_contact,
+            source,
+        } = self.free_surface_and_source(dt, dt_own);
 
         for v in &mut self.scratch.v[nf..] {
             *v = [0.0, 0.0];

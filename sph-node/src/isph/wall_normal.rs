@@ -17,12 +17,12 @@
 //! where the surface meets a side wall cross the face within 0.3 s.
 //!
 //! The normal n of a wall particle is the direction to the nearest point outside every wall box
-//! ([`super::wall_guard::WallBoxes::exit_direction`]): the face normal, or the diagonal in a corner where two boxes
+//! ([`crate::boundary::wall_guard::WallBoxes::exit_direction`]): the face normal, or the diagonal in a corner where two boxes
 //! meet. Its sign does not matter: both terms are products of two projections on n.
 
 use rayon::prelude::*;
 
-use super::wall_guard::WallBoxes;
+use crate::boundary::wall_guard::WallBoxes;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{separation, ParticleView};

@@ -7,10 +7,9 @@
 //! same order whatever the thread count.
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 /// Particles binned on a uniform grid.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CellList {
     origin: [f64; 2],
     cell_size: f64,
@@ -154,7 +153,7 @@ pub const CHUNK: usize = 256;
 /// which do not move between a search and the passes that use its lists, with the builder's own arithmetic
 /// (see [`ListChunk::grad`]). The pair arrays grow to an estimate of what the chunk needs (not by doubling) and
 /// keep their capacity from list to list.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default)]
 pub struct ListChunk {
     /// First particle of the chunk.
     first: usize,
@@ -288,7 +287,7 @@ impl ListChunk {
 
 /// Per-particle neighbour lists (self excluded), each in the fixed gather order, stored in chunks of [`CHUNK`]
 /// particles that are built in parallel and never concatenated.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default)]
 pub struct NeighborList {
     n: usize,
     chunks: Vec<ListChunk>,

@@ -9,7 +9,6 @@
 //! every sum runs over the same neighbours in the same order, so the results do not depend on the memory order
 //! (nor on the thread count).
 
-use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
 use rayon::prelude::*;
@@ -18,7 +17,7 @@ use super::cell_list::{ListChunk, NeighborList};
 use crate::kernel::CubicSpline;
 
 /// A uniform grid over a bounding box.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Grid {
     origin: [f64; 2],
     cell_size: f64,
@@ -78,7 +77,7 @@ fn bounds(x: &[[f64; 2]]) -> Option<([f64; 2], [f64; 2])> {
 }
 
 /// Fluid sorted by cell, walls binned by cell, on the grid of the current positions.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default)]
 pub struct SortedCells {
     grid: Grid,
     /// `fluid_start[c]..fluid_start[c + 1]`: the (sorted) fluid indices in cell c.

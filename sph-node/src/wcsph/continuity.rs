@@ -1,43 +1,15 @@
 //! Continuity equation, Eq. (9) of Long et al. 2016: Dρ_i/Dt = ρ_i Σ_j (m_j/ρ_j) (v_i − v_j) · ∇_i W_ij.
 
-use rayon::prelude::*;
-
 use super::density_diffusion::DensityDiffusion;
-use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
-use crate::particles::{dot, separation, ParticleView};
+use crate::particles::{dot, ParticleView};
 
-/// Dρ_i/Dt of fluid particle i (wall neighbours included, with their zero velocity).
+/// Dρ_i/Dt of fluid particle i (wall neighbours included, with their zero velocity) over its neighbours with the
+/// ∇W factors of the pairs (`grad[k]`: ∇W factor of pair (i, `neighbors[k]`), see [`crate::neighbors::ListChunk`]);
+/// `vol[j]` = m_j/ρ_j. With `diffusion`, the δ-SPH diffusive term D_i of the fluid–fluid pairs ([`DensityDiffusion`])
+/// is added, summed in the same pass over the neighbours.
 #[inline]
-pub fn density_rate(i: usize, view: &ParticleView<'_>, neighbors: &[u32], kernel: &CubicSpline) -> f64 {
-    let (xi, vi) = (view.x[i], view.v[i]);
-    let mut sum = 0.0;
-    for &j in neighbors {
-        let j = j as usize;
-        let (r_ij, r) = separation(xi, view.x[j]);
-        let grad = kernel.grad(r_ij, r);
-        let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
-        // Eq. (9), Long et al. 2016
-        sum += view.m[j] / view.rho[j] * dot(v_ij, grad);
-    }
-    view.rho[i] * sum // Eq. (9), Long et al. 2016
-}
-
-/// Dρ/Dt of every fluid particle into `out` (a parallel gather).
-pub fn density_rates_into(view: &ParticleView<'_>, list: &NeighborList, kernel: &CubicSpline, out: &mut Vec<f64>) {
-    out.clear();
-    (0..view.n_fluid)
-        .into_par_iter()
-        .map(|i| density_rate(i, view, list.of(i), kernel))
-        .collect_into_vec(out);
-}
-
-/// [`density_rate`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair
-/// (i, `neighbors[k]`), see [`crate::neighbors::ListChunk`]) and `vol[j]` = m_j/ρ_j: the same sum, bit for bit.
-/// With `diffusion`, the δ-SPH diffusive term D_i of the fluid–fluid pairs ([`DensityDiffusion`]) is added, summed
-/// in the same pass over the neighbours.
-#[inline]
-pub fn density_rate_pairs(
+pub fn density_rate(
     i: usize,
     view: &ParticleView<'_>,
     vol: &[f64],
@@ -66,17 +38,15 @@ pub fn density_rate_pairs(
     }
 }
 
-/// Dρ/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
+/// Dρ/Dt of every fluid particle into `out` (a parallel gather) from lists with ∇W factors (as built by
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j; with the δ-SPH term when `diffusion`
 /// is given.
-pub fn density_rates_pairs_into(
+pub fn density_rates_into(
     view: &ParticleView<'_>,
     vol: &[f64],
     list: &NeighborList,
     diffusion: Option<&DensityDiffusion>,
     out: &mut Vec<f64>,
 ) {
-    list.map_pairs_into(out, |i, idx, grad| {
-        density_rate_pairs(i, view, vol, idx, grad, diffusion)
-    });
+    list.map_pairs_into(out, |i, idx, grad| density_rate(i, view, vol, idx, grad, diffusion));
 }

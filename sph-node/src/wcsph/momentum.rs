@@ -1,11 +1,9 @@
 //! Momentum equation, Eq. (10) of Long et al. 2016:
 //! Dv_i/Dt = −Σ_j m_j (p_i/ρ_i² + p_j/ρ_j² + Π_ij) ∇_i W_ij + g (+ Eq. (12) when ν > 0).
 
-use rayon::prelude::*;
-
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
-use crate::particles::{dot, separation, ParticleView};
+use crate::particles::{dot, ParticleView};
 use crate::wcsph::artificial_viscosity::pi_ij;
 use crate::wcsph::laminar_viscosity::morris_factor;
 
@@ -22,73 +20,6 @@ pub struct MomentumParams {
     pub nu: f64,
 }
 
-/// Dv_i/Dt of fluid particle i.
-#[inline]
-pub fn acceleration(
-    i: usize,
-    view: &ParticleView<'_>,
-    neighbors: &[u32],
-    kernel: &CubicSpline,
-    params: &MomentumParams,
-) -> [f64; 2] {
-    let h = kernel.h();
-    let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
-    let pi_term = view.p[i] / (rho_i * rho_i);
-    let mut a = [0.0, 0.0];
-    for &j in neighbors {
-        let j = j as usize;
-        let (r_ij, r) = separation(xi, view.x[j]);
-        let grad = kernel.grad(r_ij, r);
-        let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
-        let rho_j = view.rho[j];
-        let visc = if params.alpha > 0.0 {
-            pi_ij(
-                params.alpha,
-                params.c0,
-                h,
-                dot(v_ij, r_ij),
-                0.5 * (rho_i + rho_j),
-                r * r,
-            )
-        } else {
-            0.0
-        };
-        // Eq. (10), Long et al. 2016
-        let f = view.m[j] * (pi_term + view.p[j] / (rho_j * rho_j) + visc);
-        a[0] -= f * grad[0];
-        a[1] -= f * grad[1];
-    }
-    if params.nu > 0.0 {
-        for &j in neighbors {
-            let j = j as usize;
-            let (r_ij, r) = separation(xi, view.x[j]);
-            let grad = kernel.grad(r_ij, r);
-            let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
-            // Eq. (12), Long et al. 2016, ν_i = ν_j = ν
-            let f = morris_factor(view.m[j], 2.0 * params.nu, dot(r_ij, grad), view.rho[j], r * r, h);
-            a[0] += f * v_ij[0];
-            a[1] += f * v_ij[1];
-        }
-    }
-    // Eq. (10), Long et al. 2016: body force
-    [a[0] + params.gravity[0], a[1] + params.gravity[1]]
-}
-
-/// Dv/Dt of every fluid particle into `out` (a parallel gather).
-pub fn accelerations_into(
-    view: &ParticleView<'_>,
-    list: &NeighborList,
-    kernel: &CubicSpline,
-    params: &MomentumParams,
-    out: &mut Vec<[f64; 2]>,
-) {
-    out.clear();
-    (0..view.n_fluid)
-        .into_par_iter()
-        .map(|i| acceleration(i, view, list.of(i), kernel, params))
-        .collect_into_vec(out);
-}
-
 /// The pairs of one particle with their precomputed ∇W factors (see [`crate::neighbors::ListChunk`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Pairs<'a> {
@@ -98,17 +29,17 @@ pub struct Pairs<'a> {
     pub grad: &'a [f64],
 }
 
-/// r² = r · r with r = |r_ij| as [`separation`] computes it (the r² of [`acceleration`], bit for bit).
+/// r² = r · r with r = |r_ij| as [`crate::particles::separation`] computes it.
 #[inline]
 fn r2_of(r_ij: [f64; 2]) -> f64 {
     let r = (r_ij[0] * r_ij[0] + r_ij[1] * r_ij[1]).sqrt();
     r * r
 }
 
-/// [`acceleration`] with the ∇W factors of the pairs precomputed and `pr2[j]` = p_j/ρ_j²: the same sums, bit
-/// for bit (r² is recomputed from the positions, as [`acceleration`] does).
+/// Dv_i/Dt of fluid particle i over its pairs with their ∇W factors (∇_i W_ij = grad · r_ij, see
+/// [`crate::neighbors::ListChunk`]); `pr2[j]` = p_j/ρ_j².
 #[inline]
-pub fn acceleration_pairs(
+pub fn acceleration(
     i: usize,
     view: &ParticleView<'_>,
     pr2: &[f64],
@@ -160,9 +91,9 @@ pub fn acceleration_pairs(
     [a[0] + params.gravity[0], a[1] + params.gravity[1]]
 }
 
-/// Dv/Dt of every fluid particle into `out` from lists with ∇W factors (as built by
+/// Dv/Dt of every fluid particle into `out` (a parallel gather) from lists with ∇W factors (as built by
 /// [`crate::neighbors::SortedCells::build_fluid_lists`]); `pr2[j]` = p_j/ρ_j².
-pub fn accelerations_pairs_into(
+pub fn accelerations_into(
     view: &ParticleView<'_>,
     pr2: &[f64],
     list: &NeighborList,
@@ -172,6 +103,6 @@ pub fn accelerations_pairs_into(
 ) {
     let h = kernel.h();
     list.map_pairs_into(out, |i, idx, grad| {
-        acceleration_pairs(i, view, pr2, Pairs { idx, grad }, h, params)
+        acceleration(i, view, pr2, Pairs { idx, grad }, h, params)
     });
 }

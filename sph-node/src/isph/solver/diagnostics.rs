@@ -1,0 +1,65 @@
+//! What an ISPH solver tells about itself besides its state: the stable step, energies, a pressure probe, the last
+//! PPE solve and the neighbour pairs.
+
+use rayon::prelude::*;
+
+use super::{IsphSolver, PpeReport};
+
+impl IsphSolver {
+    /// Neighbour pairs of the current lists (ordered: each pair counts once for each of its particles), the wall
+    /// particles' lists included (their PPE rows need them).
+    pub fn pair_count(&self) -> usize {
+        self.scratch.list.pair_count()
+    }
+
+    /// Iterations, residual and free-surface count of the last PPE solve.
+    pub fn last_ppe(&self) -> PpeReport {
+        self.last_ppe
+    }
+
+    /// Δt = min(C h / max(v_max, sqrt(2 |g| H)), 0.25 sqrt(h/a_max), 0.125 h²/ν) (`DESIGN.md` §4.3, step 6, with
+    /// the force and viscous limits of §4.2; H is the initial fluid depth, a_max the largest acceleration of the
+    /// last step, at least |g|), times the scene's `fluid.cfl` (1 by default).
+    pub fn stable_dt(&self) -> f64 {
+        let h = self.params.h;
+        let v_max = self
+            .state
+            .v
+            .par_iter()
+            .map(|v| v[0].hypot(v[1]))
+            .reduce(|| 0.0, f64::max);
+        let v = v_max.max(self.v_ref);
+        let mut dt = f64::INFINITY;
+        if v > 0.0 {
+            dt = self.options.courant * h / v; // §4.3 step 6
+        }
+        if self.a_max > 0.0 {
+            dt = dt.min(0.25 * (h / self.a_max).sqrt()); // §4.2 force condition
+        }
+        if self.params.nu > 0.0 {
+            dt = dt.min(0.125 * h * h / self.params.nu); // §4.2 viscous condition
+        }
+        self.cfl
+            * if dt.is_finite() {
+                dt
+            } else {
+                0.25 * h // no motion, no force: any step; keep it finite
+            }
+    }
+
+    /// Σ ½ m |v|² (per unit depth).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.state.kinetic_energy()
+    }
+
+    /// Σ −m g · x (per unit depth; zero at the origin).
+    pub fn potential_energy(&self) -> f64 {
+        self.state.potential_energy(self.params.gravity)
+    }
+
+    /// Shepard-normalised SPH interpolation of the fluid pressure at `point`; `None` when no fluid particle is
+    /// within 2h.
+    pub fn sample_pressure(&self, point: [f64; 2]) -> Option<f64> {
+        self.state.sample_pressure(&self.kernel, point)
+    }
+}

@@ -1,0 +1,45 @@
+//! The ISPH solver as the node drives it: [`crate::FluidSolver`].
+
+use super::IsphSolver;
+use crate::error::Result;
+use crate::fluid_solver::{FluidSolver, SavedSolver};
+use crate::params::SphParams;
+use crate::particles::{FluidState, WallParticles};
+
+impl FluidSolver for IsphSolver {
+    fn name(&self) -> &'static str {
+        "isph"
+    }
+
+    fn params(&self) -> &SphParams {
+        IsphSolver::params(self)
+    }
+
+    fn state(&self) -> &FluidState {
+        IsphSolver::state(self)
+    }
+
+    fn state_mut(&mut self) -> &mut FluidState {
+        IsphSolver::state_mut(self)
+    }
+
+    fn walls(&self) -> &WallParticles {
+        IsphSolver::walls(self)
+    }
+
+    fn stable_dt(&self) -> f64 {
+        IsphSolver::stable_dt(self)
+    }
+
+    fn step(&mut self, dt: f64) -> Result<()> {
+        IsphSolver::step(self, dt)
+    }
+
+    fn save(&self) -> SavedSolver {
+        self.save_state()
+    }
+
+    fn restore(&mut self, saved: SavedSolver) -> std::result::Result<(), String> {
+        self.restore_state(saved)
+    }
+}

@@ -1,0 +1,160 @@
+//! The passes of a WCSPH step over the cell-sorted particles: ρ following displaced particles, the density half
+//! kick (continuity, Eq. (9)), EOS with wall pressures and accelerations (momentum, Eq. (10)), and the re-sort with
+//! the neighbour search.
+
+use rayon::prelude::*;
+
+use super::WcsphSolver;
+use crate::boundary::adami;
+use crate::boundary::repulsion::Repulsion;
+use crate::corrections::apd;
+use crate::integrator;
+use crate::wcsph::sorted::{permute, update_vol};
+use crate::wcsph::{continuity, momentum, MomentumParams};
+
+impl WcsphSolver {
+    /// ρ follows the positions edited through [`WcsphSolver::state_mut`] (the contact's corrections, `DESIGN.md` §3
+    /// step 5) as the continuity equation would follow the same displacement (Eq. (9) with δr for v Δt, as for the
+    /// APD shift: [`apd::shift_density_change`]), at the positions and neighbours of the last search.
+    ///
+    /// Without it a position correction moves a particle without any change of density: the contact, which puts
+    /// every particle it finds inside the structure back on the same line r_c in front of its face, stacked particles
+    /// up in front of the elastic gate's tip at Δx = 5 mm (some 20 in a few mm², at pressures of a few kPa), until the
+    /// stack blew apart and the energy guard stopped the run (`cosim/tests/stress.rs`,
+    /// `coarse_elastic_gate_keeps_its_water_on_the_floor`).
+    pub(super) fn density_follows_edits(&mut self) {
+        let nf = self.state.len();
+        let mut shift = std::mem::take(&mut self.scratch.per2);
+        shift.clear();
+        let s = &self.sorted;
+        shift.extend(
+            self.scratch
+                .edited_x
+                .iter()
+                .zip(&s.x[..nf])
+                .map(|(e, x)| [e[0] - x[0], e[1] - x[1]]),
+        );
+        self.density_follows_shift(&shift);
+        self.scratch.per2 = shift;
+    }
+
+    /// ρ += δρ for the displacement `shift` of each fluid particle, as the continuity equation would change it
+    /// ([`apd::shift_density_change`]), at the positions and neighbours of the last search; the volumes follow.
+    pub(super) fn density_follows_shift(&mut self, shift: &[[f64; 2]]) {
+        let nf = self.state.len();
+        let mut drho = std::mem::take(&mut self.scratch.per1);
+        apd::shift_density_change_pairs_into(&self.view(), &self.scratch.list, shift, &mut drho);
+        let s = &mut self.sorted;
+        s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
+        self.scratch.per1 = drho;
+    }
+
+    /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9), with the δ-SPH diffusion when on).
+    pub(super) fn density_half_kick(&mut self, dt: f64) {
+        let nf = self.state.len();
+        let mut drho = std::mem::take(&mut self.scratch.per1);
+        let diffusion = self.density_diffusion();
+        let (view, vol, list) = (self.view(), &self.sorted.vol, &self.scratch.list);
+        continuity::density_rates_into(&view, vol, list, diffusion.as_ref(), &mut drho);
+        let s = &mut self.sorted;
+        integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
+        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
+        self.scratch.per1 = drho;
+    }
+
+    /// EOS, wall pressures (Adami) and accelerations for the current positions, densities and velocities.
+    pub(super) fn update_pressure_and_acceleration(&mut self) {
+        let eos = self.eos;
+        let nf = self.state.len();
+        let s = &mut self.sorted;
+        s.p[..nf]
+            .par_iter_mut()
+            .zip(s.pr2[..nf].par_iter_mut())
+            .zip(s.rho[..nf].par_iter())
+            .with_min_len(1024)
+            .for_each(|((p, pr2), &r)| {
+                *p = eos.pressure(r);
+                *pr2 = *p / (r * r);
+            });
+        let mut wall = std::mem::take(&mut self.scratch.wall);
+        adami::wall_pressures_sorted_into(
+            &self.view(),
+            &self.scratch.cells,
+            &self.kernel,
+            self.params.gravity,
+            &eos,
+            &mut wall,
+        );
+        let s = &mut self.sorted;
+        s.p[nf..]
+            .par_iter_mut()
+            .zip(s.rho[nf..].par_iter_mut())
+            .zip(s.vol[nf..].par_iter_mut())
+            .zip(s.pr2[nf..].par_iter_mut())
+            .zip(s.m[nf..].par_iter())
+            .zip(self.walls.p.par_iter_mut().zip(self.walls.rho.par_iter_mut()))
+            .zip(wall.par_iter())
+            .with_min_len(1024)
+            .for_each(|((((((p, rho), vol), pr2), m), (wp, wrho)), &(pw, rw))| {
+                (*p, *rho, *wp, *wrho) = (pw, rw, pw, rw);
+                *vol = m / rw;
+                *pr2 = pw / (rw * rw);
+            });
+        self.scratch.wall = wall;
+        let params = MomentumParams {
+            gravity: self.params.gravity,
+            alpha: self.wcsph.alpha,
+            c0: self.wcsph.c0,
+            nu: self.params.nu,
+        };
+        let mut accel = std::mem::take(&mut self.sorted.accel);
+        momentum::accelerations_into(
+            &self.view(),
+            &self.sorted.pr2,
+            &self.scratch.list,
+            &self.kernel,
+            &params,
+            &mut accel,
+        );
+        let k = self.wcsph.central_force;
+        if k != 0.0 {
+            // Monaghan & Rafiee 2013: central body force f = −Ω² r
+            accel
+                .par_iter_mut()
+                .zip(self.sorted.x[..nf].par_iter())
+                .for_each(|(a, x)| {
+                    a[0] -= k * x[0];
+                    a[1] -= k * x[1];
+                });
+        }
+        if !self.wall_boxes.boxes().is_empty() {
+            // Short-range wall repulsion (boundary/repulsion.rs)
+            Repulsion::new(self.params.dx, self.wcsph.c0).add_into(&self.wall_boxes, &self.sorted.x[..nf], &mut accel);
+        }
+        self.sorted.accel = accel;
+    }
+
+    /// Re-sorts the fluid by cell for the current positions and rebuilds the neighbour lists.
+    pub(super) fn rebuild_neighbors(&mut self) {
+        let nf = self.state.len();
+        let s = &mut self.sorted;
+        let sc = &mut self.scratch;
+        sc.cells.sort(
+            &s.x[..nf],
+            &self.walls.x,
+            self.kernel.support(),
+            &mut s.ids,
+            &mut s.slot,
+            &mut sc.src,
+        );
+        let src = &sc.src;
+        for a in [&mut s.x, &mut s.v, &mut s.accel] {
+            permute(a, &mut sc.per2, src);
+        }
+        for a in [&mut s.rho, &mut s.p, &mut s.m, &mut s.vol] {
+            permute(a, &mut sc.per1, src);
+        }
+        sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
+    }
+}

@@ -1,0 +1,447 @@
+//! The cell-sorted WCSPH pipeline against plain gathers and against the solver as it was before it.
+
+use super::*;
+use crate::boundary::adami;
+use crate::boundary::adami::wall_pressure;
+use crate::boundary::repulsion::Repulsion;
+use crate::corrections::xsph::xsph_correction;
+use crate::neighbors::CellList;
+use crate::particles::separation;
+use crate::wcsph::momentum::Pairs;
+use crate::wcsph::{continuity, momentum, MomentumParams};
+
+fn dam_break(spacing: f64) -> WcsphSolver {
+    dam_break_with(spacing, &[])
+}
+
+/// [`dam_break`] with more scene overrides.
+fn dam_break_with(spacing: f64, sets: &[&str]) -> WcsphSolver {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
+    let mut sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    sets.push(format!("fluid.spacing={spacing}"));
+    let scene = cosim_proto::scene::parse("dam_break.toml", &text, &sets).unwrap();
+    let mut solver = WcsphSolver::new(&scene).unwrap();
+    for _ in 0..60 {
+        let dt = solver.stable_dt();
+        solver.step(dt).unwrap();
+    }
+    solver
+}
+
+/// The ∇W factors of the pairs of `i` with `neighbors` straight from the kernel (dW/dr / r, 0 at r = 0), as a plain
+/// gather computes ∇W where it uses it.
+fn factors(i: usize, view: &ParticleView<'_>, neighbors: &[u32], kernel: &CubicSpline) -> Vec<f64> {
+    neighbors
+        .iter()
+        .map(|&j| {
+            let (_, r) = separation(view.x[i], view.x[j as usize]);
+            if r > 0.0 {
+                kernel.dw_dr(r) / r
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// m/ρ of every particle of `view`.
+fn volumes(view: &ParticleView<'_>) -> Vec<f64> {
+    view.m.iter().zip(view.rho).map(|(m, r)| m / r).collect()
+}
+
+/// p/ρ² of every particle of `view`.
+fn pr2_of(view: &ParticleView<'_>) -> Vec<f64> {
+    view.p.iter().zip(view.rho).map(|(p, r)| p / (r * r)).collect()
+}
+
+/// Dρ_i/Dt over `neighbors` as a plain gather, ∇W computed from the kernel where it is used; `vol` = [`volumes`].
+fn density_rate(i: usize, view: &ParticleView<'_>, vol: &[f64], neighbors: &[u32], kernel: &CubicSpline) -> f64 {
+    continuity::density_rate(i, view, vol, neighbors, &factors(i, view, neighbors, kernel), None)
+}
+
+/// Dv_i/Dt over `neighbors` as a plain gather, ∇W computed from the kernel where it is used; `pr2` = [`pr2_of`].
+fn acceleration(
+    i: usize,
+    view: &ParticleView<'_>,
+    pr2: &[f64],
+    neighbors: &[u32],
+    kernel: &CubicSpline,
+    params: &MomentumParams,
+) -> [f64; 2] {
+    let grad = factors(i, view, neighbors, kernel);
+    let pairs = Pairs {
+        idx: neighbors,
+        grad: &grad,
+    };
+    momentum::acceleration(i, view, pr2, pairs, kernel.h(), params)
+}
+
+fn bits(a: &[[f64; 2]]) -> Vec<[u64; 2]> {
+    a.iter().map(|a| a.map(f64::to_bits)).collect()
+}
+
+/// The sorted lists with precomputed ∇W factors give, bit for bit, what the reference gathers give on the
+/// lists of a plain cell list over the same (sorted) particles: same neighbours in the same order, same
+/// continuity, momentum, wall pressure and XSPH.
+#[test]
+fn fast_passes_equal_the_reference_gathers() {
+    let solver = dam_break(0.005);
+    let view = solver.view();
+    let kernel = solver.kernel;
+    let nf = view.n_fluid;
+    let (vol, pr2) = (volumes(&view), pr2_of(&view));
+    assert!(
+        view.v[..nf].iter().any(|v| v[0].abs() > 1e-3),
+        "the column must be moving"
+    );
+    let cells = CellList::new(view.x, kernel.support());
+    let reference = cells.neighbor_list(view.x, view.x.len(), kernel.support());
+    let list = &solver.scratch.list;
+    for i in 0..nf {
+        assert_eq!(list.of(i), reference.of(i), "neighbours of slot {i}");
+    }
+    let mut drho = Vec::new();
+    continuity::density_rates_into(&view, &solver.sorted.vol, list, None, &mut drho);
+    for (i, d) in drho.iter().enumerate() {
+        assert_eq!(
+            d.to_bits(),
+            density_rate(i, &view, &vol, reference.of(i), &kernel).to_bits()
+        );
+    }
+    let params = MomentumParams {
+        gravity: solver.params.gravity,
+        alpha: solver.wcsph.alpha,
+        c0: solver.wcsph.c0,
+        nu: solver.params.nu,
+    };
+    assert!(params.nu > 0.0 && params.alpha > 0.0);
+    let mut accel = Vec::new();
+    momentum::accelerations_into(&view, &solver.sorted.pr2, list, &kernel, &params, &mut accel);
+    let expected: Vec<_> = (0..nf)
+        .map(|i| acceleration(i, &view, &pr2, reference.of(i), &kernel, &params))
+        .collect();
+    assert_eq!(bits(&accel), bits(&expected));
+    let mut xsph = Vec::new();
+    xsph::xsph_into(&view, list, &kernel, 0.5, &mut xsph);
+    let expected: Vec<_> = (0..nf)
+        .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
+        .collect();
+    assert_eq!(bits(&xsph), bits(&expected));
+    let mut wall = Vec::new();
+    let g = solver.params.gravity;
+    adami::wall_pressures_sorted_into(&view, &solver.scratch.cells, &kernel, g, &solver.eos, &mut wall);
+    assert!(wall.iter().any(|w| w.0 > 0.0));
+    for (w, &(p, rho)) in wall.iter().enumerate() {
+        let (ep, erho) = wall_pressure(nf + w, &view, reference.of(nf + w), &kernel, g, &solver.eos);
+        assert_eq!((p.to_bits(), rho.to_bits()), (ep.to_bits(), erho.to_bits()), "wall {w}");
+    }
+}
+
+/// Edits through `state_mut` reach the sorted working copy: handing the state out without changing it leaves
+/// the run bit-identical, and the drift starts from an edited position.
+#[test]
+fn state_edits_are_taken() {
+    // Without APD: its shift of particle 0 depends on where its neighbours are, which the edit moves too.
+    let mut a = dam_break_with(0.01, &["fluid.apd=0"]);
+    let mut b = a.clone();
+    let _ = b.state_mut();
+    for _ in 0..20 {
+        let dt = a.stable_dt();
+        a.step(dt).unwrap();
+        b.step(dt).unwrap();
+    }
+    assert_eq!(a.state(), b.state());
+    // Move particle 0: the step's first density rate and XSPH use the last search's positions, as they
+    // always have, and the drift starts from the edited one; the densities of particle 0 and its neighbours
+    // follow the move (`density_follows_edits`), and the step's first density rate carries that 2h further,
+    // which changes the XSPH of the particles within 2h of those (2.4e-10 m for particle 0 here): particle 0
+    // lands 1e-4 m further, and every particle beyond 6h lands where it did.
+    let x0 = a.state().x[0];
+    a.state_mut().x[0] = [x0[0] + 1e-4, x0[1]];
+    let dt = a.stable_dt();
+    a.step(dt).unwrap();
+    b.step(dt).unwrap();
+    let (xa, xb) = (&a.state().x, &b.state().x);
+    assert!((xa[0][0] - xb[0][0] - 1e-4).abs() < 1e-8 && (xa[0][1] - xb[0][1]).abs() < 1e-8);
+    let far = 3.0 * a.kernel.support();
+    let beyond: Vec<usize> = (1..xa.len()).filter(|&i| separation(xb[i], x0).1 > far).collect();
+    assert!(beyond.len() > xa.len() / 2);
+    assert!(beyond.iter().all(|&i| xa[i] == xb[i]));
+    assert_ne!(a.state().v, b.state().v);
+    // The neighbour lists are those of the new positions.
+    let list = &a.scratch.list;
+    let view = a.view();
+    let cells = CellList::new(view.x, a.kernel.support());
+    let reference = cells.neighbor_list(view.x, view.x.len(), a.kernel.support());
+    assert!((0..view.n_fluid).all(|i| list.of(i) == reference.of(i)));
+}
+
+/// A position edit raises the density of a particle moved towards its neighbours as the continuity equation
+/// would (`density_follows_edits`): the top particle of the column, whose neighbours all lie below it, moved
+/// down by Δx/100 gains δρ = Σ_j m_j δr·∇W_ij, within 2 % (the rest of the difference is the step's own
+/// continuity at the two positions).
+#[test]
+fn a_position_edit_moves_the_density() {
+    let mut a = dam_break(0.01);
+    let mut b = a.clone();
+    let top = (0..a.state().len())
+        .max_by(|&i, &j| a.state().x[i][1].total_cmp(&a.state().x[j][1]))
+        .unwrap();
+    let dy = -1e-4;
+    let expected = {
+        let view = a.view();
+        let k = a.sorted.slot[top] as usize;
+        let mut shift = vec![[0.0; 2]; view.n_fluid];
+        shift[k] = [0.0, dy];
+        apd::shift_density_change(k, &view, a.scratch.list.of(k), &a.kernel, &shift)
+    };
+    assert!(expected > 1.0, "the top particle is compressed: {expected}");
+    let x = a.state().x[top];
+    a.state_mut().x[top] = [x[0], x[1] + dy];
+    let dt = 1e-6;
+    a.step(dt).unwrap();
+    b.step(dt).unwrap();
+    let gained = a.state().rho[top] - b.state().rho[top];
+    assert!(
+        (gained - expected).abs() < 0.02 * expected,
+        "gained {gained}, expected {expected}"
+    );
+}
+
+/// The solver as it was before the cell-sorted pipeline (id order, plain gathers over a cell list of all
+/// particles, every kernel value computed where it is used), reduced to what a comparison needs.
+struct Reference {
+    params: SphParams,
+    wcsph: WcsphParams,
+    kernel: CubicSpline,
+    eos: Tait,
+    state: FluidState,
+    walls: WallParticles,
+    x: Vec<[f64; 2]>,
+    v: Vec<[f64; 2]>,
+    rho: Vec<f64>,
+    p: Vec<f64>,
+    m: Vec<f64>,
+    list: NeighborList,
+    accel: Vec<[f64; 2]>,
+    boxes: WallBoxes,
+}
+
+impl Reference {
+    fn new(params: SphParams, wcsph: WcsphParams, state: FluidState, walls: WallParticles, boxes: WallBoxes) -> Self {
+        let n = state.len() + walls.len();
+        let mut r = Self {
+            kernel: CubicSpline::new(params.h),
+            eos: Tait::new(params.rho0, wcsph.c0),
+            params,
+            wcsph,
+            m: state.m.iter().chain(&walls.m).copied().collect(),
+            v: vec![[0.0; 2]; n],
+            state,
+            walls,
+            x: Vec::new(),
+            rho: Vec::new(),
+            p: Vec::new(),
+            list: NeighborList::default(),
+            accel: Vec::new(),
+            boxes,
+        };
+        r.rebuild();
+        r.update();
+        r
+    }
+
+    fn view(&self) -> ParticleView<'_> {
+        ParticleView {
+            x: &self.x,
+            v: &self.v,
+            rho: &self.rho,
+            p: &self.p,
+            m: &self.m,
+            n_fluid: self.state.len(),
+        }
+    }
+
+    fn sync(&mut self) {
+        let nf = self.state.len();
+        self.v[..nf].copy_from_slice(&self.state.v);
+        self.rho = self.state.rho.iter().chain(&self.walls.rho).copied().collect();
+        self.p = self.state.p.iter().chain(&self.walls.p).copied().collect();
+    }
+
+    fn rebuild(&mut self) {
+        self.x = self.state.x.iter().chain(&self.walls.x).copied().collect();
+        let cells = CellList::new(&self.x, self.kernel.support());
+        self.list = cells.neighbor_list(&self.x, self.x.len(), self.kernel.support());
+    }
+
+    fn continuity(&mut self, dt: f64) {
+        self.sync();
+        let view = self.view();
+        let vol = volumes(&view);
+        let drho: Vec<f64> = (0..view.n_fluid)
+            .map(|i| density_rate(i, &view, &vol, self.list.of(i), &self.kernel))
+            .collect();
+        integrator::half_kick_density(&mut self.state.rho, &drho, dt);
+    }
+
+    fn update(&mut self) {
+        let eos = self.eos;
+        self.state.p = self.state.rho.iter().map(|&r| eos.pressure(r)).collect();
+        self.sync();
+        let nf = self.state.len();
+        let view = self.view();
+        let g = self.params.gravity;
+        let wall: Vec<_> = (nf..view.x.len())
+            .map(|w| wall_pressure(w, &view, self.list.of(w), &self.kernel, g, &eos))
+            .collect();
+        for (w, &(p, rho)) in wall.iter().enumerate() {
+            (self.walls.p[w], self.walls.rho[w]) = (p, rho);
+            (self.p[nf + w], self.rho[nf + w]) = (p, rho);
+        }
+        let params = MomentumParams {
+            gravity: g,
+            alpha: self.wcsph.alpha,
+            c0: self.wcsph.c0,
+            nu: self.params.nu,
+        };
+        let view = self.view();
+        let pr2 = pr2_of(&view);
+        self.accel = (0..nf)
+            .map(|i| acceleration(i, &view, &pr2, self.list.of(i), &self.kernel, &params))
+            .collect();
+        let k = self.wcsph.central_force;
+        let repulsion = Repulsion::new(self.params.dx, self.wcsph.c0);
+        for (a, x) in self.accel.iter_mut().zip(&self.state.x) {
+            if k != 0.0 {
+                a[0] -= k * x[0];
+                a[1] -= k * x[1];
+            }
+            let r = repulsion.acceleration(&self.boxes, *x);
+            a[0] += r[0];
+            a[1] += r[1];
+        }
+    }
+
+    fn step(&mut self, dt: f64) {
+        let step_no = self.state.step + 1;
+        let nf = self.state.len();
+        if self.state.x[..] != self.x[..nf] {
+            // Edited positions: ρ follows them as the continuity equation would.
+            let shift: Vec<[f64; 2]> = (0..nf)
+                .map(|i| [self.state.x[i][0] - self.x[i][0], self.state.x[i][1] - self.x[i][1]])
+                .collect();
+            self.sync();
+            let view = self.view();
+            let drho: Vec<f64> = (0..nf)
+                .map(|i| apd::shift_density_change(i, &view, self.list.of(i), &self.kernel, &shift))
+                .collect();
+            self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+        }
+        integrator::half_kick(&mut self.state.v, &self.accel, dt);
+        self.continuity(dt);
+        let mut corr = Vec::new();
+        if self.params.xsph > 0.0 {
+            self.sync();
+            let view = self.view();
+            corr = (0..view.n_fluid)
+                .map(|i| xsph_correction(i, &view, self.list.of(i), &self.kernel, self.params.xsph))
+                .collect();
+        }
+        let mut shift = Vec::new();
+        if self.wcsph.apd > 0.0 {
+            let v_max = self.state.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+            if v_max > 0.0 {
+                self.sync();
+                let ap = apd::ApdParams {
+                    beta: self.wcsph.apd,
+                    v_max,
+                    dt,
+                };
+                let mut drho = Vec::new();
+                apd::apd_into(&self.view(), &self.list, &self.kernel, &ap, &mut shift);
+                apd::shift_density_change_into(&self.view(), &self.list, &self.kernel, &shift, &mut drho);
+                self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+            }
+        }
+        integrator::drift(&mut self.state.x, &self.state.v, &corr, dt);
+        if !shift.is_empty() {
+            integrator::drift(&mut self.state.x, &shift, &[], 1.0);
+        }
+        self.rebuild();
+        self.continuity(dt);
+        if let Some(n) = self.wcsph.shepard_interval {
+            if step_no % u64::from(n.max(1)) == 0 {
+                self.sync();
+                let mut filtered = Vec::new();
+                if self.wcsph.mls {
+                    mls::mls_into(&self.view(), &self.list, &self.kernel, &mut filtered);
+                } else {
+                    density_filter::shepard_into(&self.view(), &self.list, &self.kernel, &mut filtered);
+                }
+                self.state.rho = filtered;
+            }
+        }
+        self.update();
+        integrator::half_kick(&mut self.state.v, &self.accel, dt);
+        self.state.t += dt;
+        self.state.step = step_no;
+    }
+}
+
+/// Over a run with MLS, APD, viscosity, XSPH and edits through `state_mut` (positions and velocities of some
+/// particles, as the contact corrections make), the solver stays bit-identical to the reference: state, wall
+/// pressures and accelerations after every step, with 1 and 2 threads.
+#[test]
+fn equals_the_reference_solver_bit_for_bit() {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
+    let overrides = [
+        "fluid.spacing=0.005".to_string(),
+        "fluid.density_filter=\"mls\"".to_string(),
+        "fluid.density_filter_interval=7".to_string(),
+    ];
+    let scene = cosim_proto::scene::parse("dam_break.toml", &text, &overrides).unwrap();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut solver = WcsphSolver::new(&scene).unwrap();
+            solver.set_apd(0.05);
+            let mut reference = Reference::new(
+                solver.params.clone(),
+                solver.wcsph.clone(),
+                solver.state.clone(),
+                solver.walls.clone(),
+                solver.wall_boxes.clone(),
+            );
+            for step in 0..150 {
+                if step % 25 == 10 {
+                    for i in (0..solver.state.len()).step_by(97) {
+                        let kick = [1e-3 * (i % 7) as f64, -2e-3];
+                        let shift = [1e-5 * (i % 3) as f64, 1e-5];
+                        for st in [solver.state_mut(), &mut reference.state] {
+                            st.v[i] = [st.v[i][0] + kick[0], st.v[i][1] + kick[1]];
+                            st.x[i] = [st.x[i][0] + shift[0], st.x[i][1] + shift[1]];
+                        }
+                    }
+                }
+                let dt = solver.stable_dt();
+                solver.step(dt).unwrap();
+                reference.step(dt);
+                assert!(
+                    solver.state == reference.state,
+                    "state after step {step}, {threads} threads"
+                );
+                assert_eq!(solver.walls, reference.walls, "walls after step {step}");
+                assert_eq!(
+                    bits(&solver.accel),
+                    bits(&reference.accel),
+                    "accelerations after step {step}"
+                );
+            }
+            assert!(
+                solver.state.v.iter().any(|v| v[0].abs() > 1e-2),
+                "the column must be moving"
+            );
+        });
+    }
+}
