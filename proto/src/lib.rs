@@ -7,7 +7,6 @@ pub mod keys;
 pub mod messages;
 pub mod overlap;
 pub mod scene;
-pub mod session;
 pub mod validate;
 
 pub use scene::sizing;
