@@ -6,6 +6,7 @@ pub mod envelope;
 pub mod keys;
 pub mod messages;
 pub mod overlap;
+pub mod run_status;
 pub mod scene;
 pub mod validate;
 
