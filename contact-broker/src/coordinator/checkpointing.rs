@@ -8,9 +8,9 @@ use anyhow::Context;
 use cosim_proto::scene::LoadedScene;
 
 use super::contact_pass::ContactPass;
+use super::inputs::{Nodes, RunInfo};
 use super::sampling::Outputs;
 use super::step_time::{Clock, Step, LANDING};
-use super::{Nodes, RunInfo};
 use crate::checkpoint::{self, BrokerState};
 use crate::interface::Corrections;
 use crate::summary::Summary;

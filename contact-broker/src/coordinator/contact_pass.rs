@@ -10,8 +10,8 @@ use cosim_proto::messages::StepCommand;
 use cosim_proto::scene::Scene;
 
 use super::exchange::{commands, Round};
+use super::inputs::Nodes;
 use super::step_time::Step;
-use super::Nodes;
 use crate::interface::{Corrections, Interface, PassStats};
 use crate::summary::{ContactStats, Summary};
 

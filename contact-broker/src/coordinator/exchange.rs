@@ -8,7 +8,7 @@ use anyhow::Context;
 use cosim_proto::messages::{FemState, SphState, StepCommand};
 use cosim_proto::validate::{Asked, Invalid};
 
-use super::Nodes;
+use super::inputs::Nodes;
 use crate::interface::Corrections;
 use crate::link::LinkError;
 use crate::summary::Summary;

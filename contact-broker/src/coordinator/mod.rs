@@ -8,19 +8,19 @@
 //! frames at the output times), `progress.rs` (the report to whoever runs it, who may stop it) and
 //! `checkpointing.rs` (checkpoints between two steps, and continuing from one).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use cosim_proto::run_status::RunStatus;
 use cosim_proto::scene::LoadedScene;
 
-use crate::checkpoint::BrokerState;
-use crate::link::{FemLink, LinkError, SphLink};
+use crate::link::LinkError;
 use crate::summary::{Summary, SummaryBuilder};
 
 mod checkpointing;
 mod contact_pass;
 mod exchange;
+mod inputs;
 mod progress;
 mod sampling;
 mod step_time;
@@ -28,20 +28,10 @@ mod step_time;
 use checkpointing::{RunState, Schedule};
 use contact_pass::ContactPass;
 use exchange::check_registrations;
+pub use inputs::{Checkpoints, Nodes, RunInfo};
 pub use progress::{Control, Progress};
 use sampling::{Outputs, Series};
 use step_time::Clock;
-
-/// How the run is launched, for the summary.
-#[derive(Clone, Debug)]
-pub struct RunInfo {
-    /// Run id.
-    pub run_id: String,
-    /// `processes` | `in-process`.
-    pub mode: String,
-    /// Output folder.
-    pub out: PathBuf,
-}
 
 /// A finished run: its summary (also written to `summary.json`) and the error that ended it, if any.
 pub struct Outcome {
@@ -49,23 +39,6 @@ pub struct Outcome {
     pub summary: Summary,
     /// Set when the run did not finish.
     pub error: Option<anyhow::Error>,
-}
-
-/// The nodes of a run; a scene without fluid has no fluid node and vice versa.
-pub struct Nodes<'a> {
-    /// The structure node.
-    pub fem: Option<&'a mut FemLink>,
-    /// The fluid node.
-    pub sph: Option<&'a mut SphLink>,
-}
-
-/// Checkpoints to write, and the one to continue from.
-#[derive(Debug, Default)]
-pub struct Checkpoints {
-    /// Write `DIR/checkpoints/<step>/` at the first step at or after every multiple of this simulated time [s].
-    pub interval: Option<f64>,
-    /// Continue from this checkpoint's coordinator state (the nodes were given theirs when they started).
-    pub restart: Option<BrokerState>,
 }
 
 /// Run a scene to its end time (or to the first failure) and write every output.

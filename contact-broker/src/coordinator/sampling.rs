@@ -11,7 +11,7 @@ use cosim_proto::messages::{FemMesh, SphSnapshot};
 use cosim_proto::scene::LoadedScene;
 
 use super::exchange::Round;
-use super::Nodes;
+use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::Probes;
