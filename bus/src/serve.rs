@@ -9,6 +9,7 @@ use anyhow::Context;
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic, NodeTopics};
 use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
+use cosim_proto::run_status::RunStatus;
 use cosim_proto::scene::Scene;
 use serde::Serialize;
 use zenoh::bytes::ZBytes;
@@ -129,9 +130,9 @@ pub fn serve<C: NodeCore>(
         .congestion_control(CongestionControl::Block)
         .wait()
         .map_err(zerr)?;
-    let report = |status: &str, message: String| {
+    let report = |status: RunStatus, message: String| {
         let body = NodeError {
-            status: status.into(),
+            status: status.as_str().into(),
             message,
         };
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
@@ -146,7 +147,11 @@ pub fn serve<C: NodeCore>(
     if let Err(e) = &result {
         let unstable = e.downcast_ref::<Failure>().is_some_and(|f| f.unstable);
         report(
-            if unstable { "unstable" } else { "failed" },
+            if unstable {
+                RunStatus::Unstable
+            } else {
+                RunStatus::Failed
+            },
             format!("{e:#}").replace('\n', " "),
         );
         // Let the report leave before the session closes.

@@ -1,7 +1,7 @@
 //! Contact algorithms and the step coordinator of the FEM–SPH co-simulation.
 //!
-//! `coordinator`, `probes`, `summary` and `output` are pure (files, no messaging); `transport` is the zenoh
-//! adapter used by the `contact-broker` binary.
+//! `coordinator`, `probes`, `summary` and `output` are pure (files, no messaging); `setup` is the set-up of a run
+//! that `cosim run` and the `contact-broker` binary share; `transport` is the zenoh adapter used by the binary.
 #![warn(missing_docs)]
 
 pub mod checkpoint;
@@ -11,5 +11,6 @@ pub mod interface;
 pub mod link;
 pub mod output;
 pub mod probes;
+pub mod setup;
 pub mod summary;
 pub mod transport;

@@ -7,6 +7,7 @@
 use std::collections::BTreeMap;
 
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState, StepCommand};
+use cosim_proto::run_status::RunStatus;
 
 /// Why a node could not answer.
 #[derive(Debug, thiserror::Error)]
@@ -30,11 +31,11 @@ pub enum LinkError {
 }
 
 impl LinkError {
-    /// `unstable` or `failed`, for `summary.json`.
-    pub fn status(&self) -> &'static str {
+    /// How the run ends: `unstable` or `failed`.
+    pub fn status(&self) -> RunStatus {
         match self {
-            LinkError::Unstable { .. } => "unstable",
-            LinkError::Failed { .. } => "failed",
+            LinkError::Unstable { .. } => RunStatus::Unstable,
+            LinkError::Failed { .. } => RunStatus::Failed,
         }
     }
 }

@@ -10,10 +10,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use contact_broker::checkpoint;
-use contact_broker::coordinator::{self, Nodes, Progress, RunInfo};
+use contact_broker::coordinator::{Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
-use contact_broker::summary;
+use contact_broker::setup::RunSetup;
+use contact_broker::summary::{self, SummaryBuilder};
 use contact_broker::transport::{self, ZenohLink};
 use cosim_bus::interrupt::Interrupt;
 use cosim_bus::status::{serve_status, Board};
@@ -90,14 +90,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         "--run `{}`: use letters, digits, - and _ only",
         args.run
     );
-    let scene = cosim_proto::scene::load(&args.scene, &args.set)?;
-    let file = args.scene.display().to_string();
-    cosim_bus::memory::refuse_above(&scene.scene, Part::Broker, &file, cosim_bus::memory::available())?;
-    checkpoint::check_interval(args.checkpoint_interval)?;
-    let restart = match &args.restart {
-        Some(dir) => Some(checkpoint::open(dir, &scene)?),
-        None => None,
-    };
+    let setup = RunSetup::load(&args.scene, &args.set, Part::Broker)?
+        .with_checkpoints(args.checkpoint_interval, args.restart.as_deref())?;
     // From here on a signal stops the run between two steps instead of killing the broker mid-step.
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let base = args.zenoh_config.as_deref();
@@ -122,7 +116,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     // still gets the summary that says so (`contact_broker::summary`).
     summary::reserve(&args.out, &args.run, &args.mode)?;
     // The body keeps a handle of the session (a shared one: cloning it opens nothing).
-    let result = serve(&args, &scene, restart, session.clone(), endpoints, &interrupt);
+    let result = serve(&args, &setup, session.clone(), endpoints, &interrupt);
     // A run that failed before the coordinator wrote its summary (a node that never registered): say why there.
     if let Err(e) = &result {
         let written = std::fs::read_to_string(args.out.join(summary::FILE))
@@ -130,8 +124,9 @@ fn run(args: Args) -> anyhow::Result<()> {
             .and_then(|t| serde_json::from_str::<summary::Summary>(&t).ok())
             .is_some_and(|s| !s.is_placeholder());
         if !written {
-            let mut failed = summary::Summary::failed(&args.run, &args.mode, format!("{e:#}").replace('\n', " "));
-            failed.wall_seconds = started.elapsed().as_secs_f64();
+            let failed = SummaryBuilder::new(&args.run, &args.mode)
+                .wall_seconds(started.elapsed().as_secs_f64())
+                .failed(format!("{e:#}").replace('\n', " "));
             if let Err(e) = summary::write(&args.out, &failed) {
                 cosim_bus::log::say(&format!("contact-broker: {e}"));
             }
@@ -143,12 +138,12 @@ fn run(args: Args) -> anyhow::Result<()> {
 /// The run, from the declarations on its keys to its end.
 fn serve(
     args: &Args,
-    scene: &cosim_proto::scene::LoadedScene,
-    restart: Option<checkpoint::Restart>,
+    setup: &RunSetup,
     session: zenoh::Session,
     endpoints: Vec<String>,
     interrupt: &Interrupt,
 ) -> anyhow::Result<()> {
+    let scene = &setup.scene;
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
     let fem_subs = match scene.scene.solids.is_empty() {
         false => Some(transport::subscribe(&session, &args.run, cosim_proto::keys::FEM)?),
@@ -161,22 +156,12 @@ fn serve(
     let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
     // Each node asks, once it has the scene, whether it continues from a saved state.
     let saved = |data: Option<&Vec<u8>>| {
-        let r = restart.as_ref()?;
+        let r = setup.restart.as_ref()?;
         Some((r.broker.step, r.broker.t, data?.clone()))
     };
     let _restore = (
-        transport::serve_restore(
-            &session,
-            &args.run,
-            cosim_proto::keys::FEM,
-            saved(restart.as_ref().and_then(|r| r.fem.as_ref())),
-        )?,
-        transport::serve_restore(
-            &session,
-            &args.run,
-            cosim_proto::keys::SPH,
-            saved(restart.as_ref().and_then(|r| r.sph.as_ref())),
-        )?,
+        transport::serve_restore(&session, &args.run, cosim_proto::keys::FEM, saved(setup.saved_fem()))?,
+        transport::serve_restore(&session, &args.run, cosim_proto::keys::SPH, saved(setup.saved_sph()))?,
     );
     let _alive = session
         .liveliness()
@@ -256,13 +241,9 @@ fn serve(
         }
         ControlFlow::Continue(())
     };
-    let plan = coordinator::Checkpoints {
-        interval: args.checkpoint_interval,
-        restart: restart.map(|r| r.broker),
-    };
-    let outcome = coordinator::run_with(scene, nodes, &info, &plan, &mut report);
+    let outcome = setup.run(nodes, &info, &mut report);
     board.update(|s| {
-        s.health = if outcome.summary.status == "ok" {
+        s.health = if outcome.summary.status.is_ok() {
             "finished"
         } else {
             "failed"

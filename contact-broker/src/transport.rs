@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use cosim_proto::envelope::{CodecError, Envelope};
 use cosim_proto::keys::{key, topic, NodeTopics};
 use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
+use cosim_proto::run_status::RunStatus;
 use serde::de::DeserializeOwned;
 use zenoh::bytes::ZBytes;
 use zenoh::handlers::FifoChannelHandler;
@@ -116,13 +117,15 @@ pub struct ZenohLink<S, T> {
 fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkError> {
     let node = topics.name.to_string();
     match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, topics.error) {
-        Ok(env) if env.body.status == "unstable" => Some(LinkError::Unstable {
-            node,
-            message: env.body.message,
-        }),
-        Ok(env) => Some(LinkError::Failed {
-            node,
-            message: env.body.message,
+        Ok(env) => Some(match RunStatus::of_node_report(&env.body.status) {
+            RunStatus::Unstable => LinkError::Unstable {
+                node,
+                message: env.body.message,
+            },
+            _ => LinkError::Failed {
+                node,
+                message: env.body.message,
+            },
         }),
         Err(e) => {
             tracing::error!("{node}: refused an error report: {e}");

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use contact_broker::coordinator::{self, Control, Nodes, RunInfo};
 use contact_broker::link::{InProcess, LinkError};
 use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState, StepCommand};
+use cosim_proto::run_status::RunStatus;
 use cosim_proto::scene::{self, LoadedScene};
 use fem_node::core::FemCore;
 use proptest::prelude::*;
@@ -345,7 +346,7 @@ fn spoil_sph(s: &mut SphState, particles: u32, how: &SphSpoil) -> Option<&'stati
 
 /// What a spoilt run ended with: its status and message, and the field the spoil named (None when the spoil did not
 /// apply to any message of this run, e.g. a snapshot spoil at a step without one).
-fn run_spoilt(spoil: &Spoil) -> (String, String, Option<&'static str>) {
+fn run_spoilt(spoil: &Spoil) -> (RunStatus, String, Option<&'static str>) {
     let scene = scene();
     let fem = FemCore::new(&scene.scene).expect("fem core");
     let sph = SphCore::new(&scene.scene).expect("sph core");
@@ -411,9 +412,9 @@ proptest! {
     fn the_broker_refuses_every_inconsistent_message_naming_its_field(spoil in spoils()) {
         let (status, message, field) = run_spoilt(&spoil);
         match field {
-            None => prop_assert_eq!(status, "ok", "{}", message),
+            None => prop_assert_eq!(status, RunStatus::Ok, "{}", message),
             Some(field) => {
-                prop_assert!(status == "failed" || status == "unstable", "{status}: {message}");
+                prop_assert!(status == RunStatus::Failed || status == RunStatus::Unstable, "{status}: {message}");
                 prop_assert!(message.contains("sent an unusable message"), "{message}");
                 let node = match spoil {
                     Spoil::Mesh(_) | Spoil::Fem { .. } => "fem-node",

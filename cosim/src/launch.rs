@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use contact_broker::coordinator::{write_summary, Progress, RunInfo};
-use contact_broker::summary::Summary;
+use contact_broker::summary::{Summary, SummaryBuilder};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::scene::Scene;
 
@@ -197,7 +197,7 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     for s in &args.set {
         broker_args.extend(["--set".into(), s.clone()]);
     }
-    // Through a router every process is a zenoh client (see `cosim_proto::session::client_settings`).
+    // Through a router every process is a zenoh client (see `cosim_bus::session`, client settings).
     if let Some(c) = &args.connect {
         broker_args.extend(["--connect".into(), c.clone(), "--client".into()]);
     }
@@ -371,9 +371,11 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
                     .collect();
                 format!("{how}; {}", nodes.join("; "))
             };
-            let mut summary = Summary::failed(&info.run_id, &info.mode, message);
-            summary.wall_seconds = started.elapsed().as_secs_f64();
-            kept_outputs(&info.out, &mut summary);
+            let (samples, sim_time, frames) = kept_outputs(&info.out);
+            let summary = SummaryBuilder::new(&info.run_id, &info.mode)
+                .wall_seconds(started.elapsed().as_secs_f64())
+                .kept(samples, sim_time, frames)
+                .failed(message);
             write_summary(&info.out, &summary)?;
             Ok(summary)
         }
@@ -405,18 +407,19 @@ fn announce_external(
     Ok(())
 }
 
-/// What a broker that died left on disk: the probe samples (rows of `probes.csv`, the last one's time) and the
-/// frames, so that the summary says what was kept.
-fn kept_outputs(out: &Path, summary: &mut Summary) {
+/// What a broker that died left on disk, so that the summary says what was kept: the probe samples (rows of
+/// `probes.csv`), the last one's time, and the frames.
+fn kept_outputs(out: &Path) -> (u64, f64, u64) {
+    let (mut samples, mut sim_time) = (0, 0.0);
     if let Ok(text) = std::fs::read_to_string(out.join("probes.csv")) {
         let rows: Vec<&str> = text.lines().skip(1).filter(|l| !l.trim().is_empty()).collect();
-        summary.samples = rows.len() as u64;
+        samples = rows.len() as u64;
         if let Some(t) = rows
             .last()
             .and_then(|l| l.split(',').next())
             .and_then(|t| t.parse().ok())
         {
-            summary.sim_time = t;
+            sim_time = t;
         }
     }
     // One frame is one time: count the structure's files, or the particles' in a fluid-only run.
@@ -431,5 +434,5 @@ fn kept_outputs(out: &Path, summary: &mut Summary) {
                 .count() as u64
         })
     };
-    summary.frames = count("structure_").max(count("particles_"));
+    (samples, sim_time, count("structure_").max(count("particles_")))
 }

@@ -4,13 +4,13 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use contact_broker::checkpoint::{self, Restart};
-use contact_broker::coordinator::{self, Checkpoints, Nodes, RunInfo};
+use contact_broker::coordinator::{Nodes, RunInfo};
 use contact_broker::link::{FemLink, SphLink};
+use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
-use cosim_proto::scene::{self, LoadedScene};
+use cosim_proto::scene::LoadedScene;
 use cosim_proto::sizing::Part;
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
@@ -22,10 +22,9 @@ use crate::progress::Bar;
 
 /// Run a scene; `Err` only for bad input (exit 2), a failed run is exit 1 with one line on stderr.
 pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
-    let scene = scene::load(&args.scene, &args.set)?;
     // Before anything is built or started: a scene too big for this machine is bad input, said with its key.
-    let file = args.scene.display().to_string();
-    cosim_bus::memory::refuse_above(&scene.scene, Part::Run, &file, cosim_bus::memory::available())?;
+    let setup = RunSetup::load(&args.scene, &args.set, Part::Run)?;
+    let scene = &setup.scene;
     let run_id = match &args.run_id {
         Some(id) if valid_run_id(id) => id.clone(),
         Some(id) => anyhow::bail!("--run-id `{id}`: use 1–64 letters, digits, - and _"),
@@ -72,7 +71,6 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             args.wait_external
         );
     }
-    checkpoint::check_interval(args.checkpoint_interval)?;
     if let (Some(node), true) = (
         args.external,
         args.checkpoint_interval.is_some() || args.restart.is_some(),
@@ -84,16 +82,14 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         );
     }
     // Checked here, before anything is cleared or started: the wrong checkpoint is bad input (exit 2).
-    let restart = match &args.restart {
-        Some(dir) => Some(checkpoint::open(dir, &scene)?),
-        None => None,
-    };
+    let setup = setup.with_checkpoints(args.checkpoint_interval, args.restart.as_deref())?;
+    let scene = &setup.scene;
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
     // A restart into the folder of the run it continues keeps that run's frames; anywhere else they are cleared.
-    let own_folder = restart.as_ref().is_some_and(|r| {
+    let own_folder = setup.restart.as_ref().is_some_and(|r| {
         let parent = r
             .dir
             .canonicalize()
@@ -111,10 +107,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     if let (Some(connect), false) = (&args.connect, args.in_process) {
         launch::ensure_run_id_free(connect, args.zenoh_config.as_deref(), &info.run_id)?;
     }
-    prepare_out(&out, &scene, &info, own_folder)?;
+    prepare_out(&out, scene, &info, own_folder)?;
     let bar = Bar::new(args.quiet);
     let result = if args.in_process {
-        run_in_process(args, &scene, &info, restart, &bar)
+        run_in_process(args, &setup, &info, &bar)
     } else {
         launch::run_processes(args, &scene.scene, &info, &bar)
     };
@@ -137,7 +133,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             return Ok(ExitCode::from(1));
         }
     };
-    if summary.status == "ok" {
+    if summary.status.is_ok() {
         println!(
             "ok: {} steps to t = {} s in {:.2} s ({}) -> {}",
             summary.steps,
@@ -192,20 +188,16 @@ fn prepare_out(out: &Path, scene: &LoadedScene, info: &RunInfo, keep_frames: boo
     Ok(())
 }
 
-fn run_in_process(
-    args: &RunArgs,
-    scene: &LoadedScene,
-    info: &RunInfo,
-    restart: Option<Restart>,
-    bar: &Bar,
-) -> anyhow::Result<contact_broker::summary::Summary> {
+/// The run in this process: the solver cores (restored from the checkpoint, if any) driven by the coordinator.
+fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -> anyhow::Result<Summary> {
     if let Some(n) = args.threads {
         rayon_threads(n)?;
     }
+    let scene = &setup.scene;
     let mut fem = match scene.scene.solids.is_empty() {
         false => {
             let mut core = FemCore::new(&scene.scene).context("fem-node")?;
-            if let Some(data) = restart.as_ref().and_then(|r| r.fem.as_ref()) {
+            if let Some(data) = setup.saved_fem() {
                 core.restore(data)
                     .context("fem-node: cannot restart from the checkpoint")?;
             }
@@ -216,7 +208,7 @@ fn run_in_process(
     let mut sph = match scene.scene.fluid {
         Some(_) => {
             let mut core = SphCore::new(&scene.scene).context("sph-node")?;
-            if let Some(data) = restart.as_ref().and_then(|r| r.sph.as_ref()) {
+            if let Some(data) = setup.saved_sph() {
                 core.restore(data)
                     .context("sph-node: cannot restart from the checkpoint")?;
             }
@@ -228,13 +220,9 @@ fn run_in_process(
         fem: fem.as_mut().map(|l| l as &mut FemLink),
         sph: sph.as_mut().map(|l| l as &mut SphLink),
     };
-    let plan = Checkpoints {
-        interval: args.checkpoint_interval,
-        restart: restart.map(|r| r.broker),
-    };
     // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once).
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
-    let outcome = coordinator::run_with(scene, nodes, info, &plan, &mut |p| {
+    let outcome = setup.run(nodes, info, &mut |p| {
         bar.update(p);
         interrupt.control()
     });

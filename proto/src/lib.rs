@@ -6,8 +6,8 @@ pub mod envelope;
 pub mod keys;
 pub mod messages;
 pub mod overlap;
+pub mod run_status;
 pub mod scene;
-pub mod session;
 pub mod validate;
 
 pub use scene::sizing;

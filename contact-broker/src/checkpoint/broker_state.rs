@@ -249,7 +249,7 @@ component = "x"
             fluid_origin: Some(vec![[0.05, 0.05]; 16]),
             rows: vec![(0.0, vec![0.4]), (0.1, vec![0.45]), (0.2, vec![0.5])],
             summary: Summary {
-                status: "ok".into(),
+                status: cosim_proto::run_status::RunStatus::Ok,
                 message: String::new(),
                 run_id: "r".into(),
                 scene: "t".into(),

@@ -10,6 +10,8 @@
 
 mod compare;
 mod csv;
+mod fields;
+mod frames;
 mod plot;
 mod pvd;
 mod queue;
@@ -20,10 +22,12 @@ use std::path::{Path, PathBuf};
 
 pub use compare::plot_compare;
 pub use csv::ProbeCsv;
+pub use fields::{Part, PointField};
+pub use frames::FrameWriter;
 pub use plot::{plot_probe, read_reference};
 pub use pvd::PvdCollection;
 pub use queue::{FrameJob, FrameQueue};
-pub use vtk::{von_mises_2d, FrameWriter, Part, PointField};
+pub use vtk::von_mises_2d;
 
 /// An output file could not be written, or an input to it was unusable. Each variant names the file.
 #[derive(Debug, thiserror::Error)]

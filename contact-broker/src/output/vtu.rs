@@ -9,7 +9,7 @@ use std::io::{self, Write};
 
 use vtkio::model::{Attribute, CellType, ElementType, IOBuffer, UnstructuredGridPiece, VertexNumbers};
 
-use super::vtk::{Part, PointField};
+use super::fields::{Part, PointField};
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 

@@ -74,7 +74,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         record.particle_steps_per_second = particle_steps / s.wall_seconds.max(1e-9);
         record.sph_seconds = s.timings.sph;
         record.sph_ns_per_particle_step = 1e9 * s.timings.sph / particle_steps.max(1.0);
-        record.status = s.status.clone();
+        record.status = s.status.to_string();
         record.message = s.message.clone();
     }
     match outcome {

@@ -1,5 +1,5 @@
-//! The zenoh session settings every node uses, as `(key, json5 value)` pairs for zenoh's `Config::insert_json5`,
-//! so that no crate but the node adapters depends on zenoh.
+//! The zenoh session settings every process uses, as `(key, json5 value)` pairs for zenoh's
+//! `Config::insert_json5`; `super` puts them on top of the base config.
 
 /// Settings of a peer session: multicast scouting off (gossip stays on so peers that only know a hub find each
 /// other), listen on `listen`, connect to `connect`, and fail within `timeout_ms` when a connect endpoint does

@@ -1,4 +1,4 @@
-//! `DIR/summary.json` (`DESIGN.md` §5), and its writing, which must succeed however little disk space is left.
+//! Writing `DIR/summary.json`, which must succeed however little disk space is left.
 //!
 //! A run reserves the file when it starts ([`reserve`]): a placeholder summary (status `failed`, message
 //! [`PLACEHOLDER`]) padded with spaces to [`RESERVED_BYTES`]. The end of the run overwrites it in place ([`write`])
@@ -7,12 +7,10 @@
 //! written. No temporary file is involved (a rename would need room for a second copy); JSON allows the trailing
 //! spaces, so the file is a valid summary at every moment a write completes.
 
-use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
+use super::Summary;
 use crate::output::{OutputError, Result};
 
 /// The summary's file name in the output folder.
@@ -26,120 +24,6 @@ pub const RESERVED_BYTES: u64 = 16 * 1024;
 /// ran it died before it could write its own.
 pub const PLACEHOLDER: &str =
     "the run ended without writing its summary (this is the placeholder written when it started)";
-
-/// Seconds spent per part of the run.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct Timings {
-    /// FEM computation (as reported by the node).
-    pub fem: f64,
-    /// SPH computation.
-    pub sph: f64,
-    /// Broker computation (contact, outputs).
-    pub broker: f64,
-    /// Round trips minus the nodes' computation.
-    pub messaging: f64,
-}
-
-/// Contact statistics.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct ContactStats {
-    /// Contacts resolved over the run.
-    pub contacts: u64,
-    /// Largest penetration seen [m].
-    pub max_penetration: f64,
-    /// Largest relative change of total linear momentum made by any step's corrections.
-    pub linear_momentum_change: f64,
-    /// Largest relative change of total angular momentum made by any step's corrections.
-    pub angular_momentum_change: f64,
-    /// Fluid particles sent to the broker per coupling step (the region of interest), on average.
-    #[serde(default)]
-    pub exchanged_per_step: f64,
-    /// Most fluid particles sent in one coupling step.
-    #[serde(default)]
-    pub exchanged_max: u64,
-}
-
-/// The run's summary.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Summary {
-    /// `ok` | `unstable` | `failed`.
-    pub status: String,
-    /// One line.
-    pub message: String,
-    /// Run id.
-    pub run_id: String,
-    /// Scene name.
-    pub scene: String,
-    /// Coupling steps taken.
-    pub steps: u64,
-    /// FEM sub-steps taken.
-    pub fem_substeps: u64,
-    /// SPH steps taken.
-    #[serde(default)]
-    pub sph_substeps: u64,
-    /// Simulated time reached [s].
-    pub sim_time: f64,
-    /// Wall time of the run [s].
-    pub wall_seconds: f64,
-    /// Fluid particles.
-    pub particles: u64,
-    /// FE nodes.
-    pub fem_nodes: u64,
-    /// FE elements.
-    pub fem_elements: u64,
-    /// Fluid solver (`none` without fluid).
-    pub solver: String,
-    /// Contact algorithm in use (`none` without fluid or solid).
-    pub contact: String,
-    /// `processes` | `in-process`.
-    pub mode: String,
-    /// Frames written.
-    pub frames: u64,
-    /// Probe samples written.
-    pub samples: u64,
-    /// Seconds per part.
-    pub timings: Timings,
-    /// Contact statistics.
-    pub contact_stats: ContactStats,
-    /// What each node counted, by node (`fem-node`, `sph-node`), as it reported at the end of the run: its sizes,
-    /// and for the WCSPH fluid `wall_pushes`, the particles its wall guard put back out of a wall over the run (a
-    /// run that needed many of them is a run to look at). Empty for a node that could not say.
-    #[serde(default)]
-    pub counts: BTreeMap<String, BTreeMap<String, u64>>,
-}
-
-impl Summary {
-    /// A run that failed before it computed anything: `message` says why.
-    pub fn failed(run_id: &str, mode: &str, message: String) -> Self {
-        Self {
-            status: "failed".into(),
-            message,
-            run_id: run_id.into(),
-            scene: String::new(),
-            steps: 0,
-            fem_substeps: 0,
-            sph_substeps: 0,
-            sim_time: 0.0,
-            wall_seconds: 0.0,
-            particles: 0,
-            fem_nodes: 0,
-            fem_elements: 0,
-            solver: "none".into(),
-            contact: "none".into(),
-            mode: mode.into(),
-            frames: 0,
-            samples: 0,
-            timings: Timings::default(),
-            contact_stats: ContactStats::default(),
-            counts: BTreeMap::new(),
-        }
-    }
-
-    /// Whether this is the placeholder [`reserve`] wrote: the run's own summary was never written.
-    pub fn is_placeholder(&self) -> bool {
-        self.status == "failed" && self.message == PLACEHOLDER
-    }
-}
 
 /// Reserve `out/summary.json` for run `run_id` (launched in `mode`) at its start: a placeholder summary padded to
 /// [`RESERVED_BYTES`]. An error names the file; a disk too full for it is better refused before the run starts.
@@ -214,6 +98,7 @@ fn fitted(path: &Path, summary: &Summary, room: usize) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use cosim_proto::run_status::RunStatus;
 
     fn summary(message: &str) -> Summary {
         Summary::failed("r1", "processes", message.into())
@@ -234,7 +119,7 @@ mod tests {
         assert_eq!(placeholder.run_id, "r1");
 
         let mut done = summary("reached t = 1 s in 10 steps");
-        done.status = "ok".into();
+        done.status = RunStatus::Ok;
         write(&out, &done).unwrap();
         let text = std::fs::read_to_string(out.join(FILE)).unwrap();
         assert_eq!(text, serde_json::to_string_pretty(&done).unwrap() + "\n");

@@ -1,7 +1,7 @@
 //! Opening zenoh sessions with the project's settings (loopback peers, multicast scouting off).
 //!
 //! Every session starts from a base config: zenoh's defaults, or a zenoh JSON5 config file (`--zenoh-config FILE`
-//! on every binary). The project's own settings (`cosim_proto::session`: mode, multicast scouting off, endpoints,
+//! on every binary). The project's own settings (`settings`: mode, multicast scouting off, endpoints,
 //! timeouts) are inserted on top of it, so the file contributes everything else: `transport/auth/usrpwd` (user and
 //! password, or a router's dictionary file), `transport/link/tls` (certificates and keys), and so on.
 
@@ -9,6 +9,8 @@ use std::path::Path;
 
 use anyhow::Context;
 use zenoh::{Session, Wait};
+
+mod settings;
 
 /// The base config: zenoh's defaults without a file, else the file (JSON5, `.json5` or `.json`; YAML `.yaml`)
 /// read with `zenoh::Config::from_file`. A file that cannot be read or parsed is one error naming it.
@@ -63,11 +65,11 @@ pub fn open_session_from(
 ) -> anyhow::Result<Session> {
     open(with_settings(
         base,
-        cosim_proto::session::peer_settings(listen, connect, timeout_ms),
+        settings::peer_settings(listen, connect, timeout_ms),
     )?)
 }
 
-/// Open a client session through the router(s) at `connect` (`cosim_proto::session::client_settings`): how every
+/// Open a client session through the router(s) at `connect` (`settings::client_settings`): how every
 /// process of a run joins when the run goes through a router instead of peer to peer.
 pub fn open_client(connect: &[String], timeout_ms: u64) -> anyhow::Result<Session> {
     open_client_from(None, connect, timeout_ms)
@@ -79,10 +81,7 @@ pub fn open_client_from(base: Option<&Path>, connect: &[String], timeout_ms: u64
         !connect.is_empty(),
         "client mode needs a router to connect to (--connect)"
     );
-    let session = open(with_settings(
-        base,
-        cosim_proto::session::client_settings(connect, timeout_ms),
-    )?);
+    let session = open(with_settings(base, settings::client_settings(connect, timeout_ms))?);
     // A router that refuses a user, a password or a certificate only closes the link: say where to look.
     match (session, base) {
         (Err(e), Some(file)) => Err(e.context(format!(
@@ -119,17 +118,14 @@ pub fn open_listening_from(
     })
 }
 
-/// Open a zenoh router (`cosim_proto::session::router_settings`) listening on `listen`, on top of the config
+/// Open a zenoh router (`settings::router_settings`) listening on `listen`, on top of the config
 /// file `base`: the hub of a run spread over hosts, where every process joins as a client. It is the router
 /// `zenohd` runs. Returns the session and the endpoints it listens on (port 0 replaced as in [`open_listening`]).
 pub fn open_router(base: Option<&Path>, listen: &[String], timeout_ms: u64) -> anyhow::Result<(Session, Vec<String>)> {
     anyhow::ensure!(!listen.is_empty(), "a router needs an endpoint to listen on (--listen)");
     base_config(base)?;
     retry_ports(listen, |endpoints| {
-        open(with_settings(
-            base,
-            cosim_proto::session::router_settings(endpoints, timeout_ms),
-        )?)
+        open(with_settings(base, settings::router_settings(endpoints, timeout_ms))?)
     })
 }
 

@@ -1,0 +1,159 @@
+//! The step barrier (`DESIGN.md` §3 steps 2–3): the commands of a coupling step go out to every node, and every
+//! node's answer comes back and is checked before anything reads it.
+
+use std::time::Instant;
+
+use anyhow::Context;
+
+use cosim_proto::messages::{FemState, SphState, StepCommand};
+use cosim_proto::validate::{Asked, Invalid};
+
+use super::inputs::Nodes;
+use crate::interface::Corrections;
+use crate::link::LinkError;
+use crate::summary::Summary;
+
+/// The answers of one coupling step.
+pub(super) struct Round {
+    pub fem: Option<FemState>,
+    pub sph: Option<SphState>,
+}
+
+/// docs/PROTOCOL.md §7 "Contents": the registrations are checked before anything indexes them.
+pub(super) fn check_registrations(nodes: &Nodes<'_>) -> anyhow::Result<()> {
+    if let Some(link) = &nodes.fem {
+        link.setup().validate().map_err(|e| unusable("fem-node", e))?;
+    }
+    if let Some(link) = &nodes.sph {
+        link.setup().validate().map_err(|e| unusable("sph-node", e))?;
+    }
+    Ok(())
+}
+
+/// A command with nothing to correct and no region of interest.
+pub(super) fn command(dt: f64, want_snapshot: bool, stop: bool) -> StepCommand {
+    StepCommand {
+        dt,
+        corrections: Vec::new(),
+        roi: None,
+        want_interface: false,
+        want_snapshot,
+        stop,
+    }
+}
+
+/// The commands of one step, (fem, sph): the pending corrections go to their node; the fluid node is asked for
+/// the particles inside `roi`, the structure node for its interface nodes, when the run is coupled.
+pub(super) fn commands(
+    dt: f64,
+    want_snapshot: bool,
+    coupled: bool,
+    roi: Option<[f64; 4]>,
+    pending: &mut Corrections,
+) -> (StepCommand, StepCommand) {
+    let fem = StepCommand {
+        corrections: std::mem::take(&mut pending.fem),
+        want_interface: coupled,
+        ..command(dt, want_snapshot, false)
+    };
+    let sph = StepCommand {
+        corrections: std::mem::take(&mut pending.sph),
+        roi,
+        want_interface: coupled,
+        ..command(dt, want_snapshot, false)
+    };
+    (fem, sph)
+}
+
+/// One coupling step with every node: send to all, then collect all, so processes compute side by side. The
+/// nodes' own compute time counts as `fem`/`sph`; the rest of the round as `messaging`: beyond the slower node where
+/// the nodes compute side by side (other processes), beyond their sum where they compute one after the other inside
+/// `receive` (in this process).
+pub(super) fn exchange(
+    nodes: &mut Nodes<'_>,
+    interface_ids: &[u32],
+    summary: &mut Summary,
+    step: u64,
+    t: f64,
+    (fem_cmd, sph_cmd): (StepCommand, StepCommand),
+) -> anyhow::Result<Round> {
+    let context = || format!("coupling step {step} from t = {t} s");
+    let asked = |cmd: &StepCommand| Asked {
+        interface: cmd.want_interface,
+        snapshot: cmd.want_snapshot,
+        interface_ids,
+    };
+    let (fem_asked, sph_asked) = (asked(&fem_cmd), asked(&sph_cmd));
+    let started = Instant::now();
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        link.send(step, t, sph_cmd).with_context(context)?;
+    }
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        link.send(step, t, fem_cmd).with_context(context)?;
+    }
+    // docs/PROTOCOL.md §7 "Contents": each answer is checked against the node's registration and the command
+    // before anything reads it.
+    let sph = match nodes.sph.as_deref_mut() {
+        Some(link) => {
+            let state = link.receive(step).with_context(context)?;
+            state
+                .validate(link.setup(), sph_asked)
+                .map_err(|e| unusable("sph-node", e))
+                .with_context(context)?;
+            Some(state)
+        }
+        None => None,
+    };
+    let fem = match nodes.fem.as_deref_mut() {
+        Some(link) => {
+            let state = link.receive(step).with_context(context)?;
+            state
+                .validate(link.setup(), fem_asked)
+                .map_err(|e| unusable("fem-node", e))
+                .with_context(context)?;
+            Some(state)
+        }
+        None => None,
+    };
+    let wall = started.elapsed().as_secs_f64();
+    let c_fem = fem.as_ref().map_or(0.0, |s| s.compute_seconds);
+    let c_sph = sph.as_ref().map_or(0.0, |s| s.compute_seconds);
+    summary.timings.fem += c_fem;
+    summary.timings.sph += c_sph;
+    let (mut side_by_side, mut in_turn) = (0.0f64, 0.0);
+    for (concurrent, c) in [
+        (nodes.fem.as_ref().is_none_or(|l| l.concurrent()), c_fem),
+        (nodes.sph.as_ref().is_none_or(|l| l.concurrent()), c_sph),
+    ] {
+        if concurrent {
+            side_by_side = side_by_side.max(c);
+        } else {
+            in_turn += c;
+        }
+    }
+    summary.timings.messaging += (wall - side_by_side - in_turn).max(0.0);
+    Ok(Round { fem, sph })
+}
+
+/// The last message of a run that reached its end: every node is told to stop.
+pub(super) fn stop(nodes: &mut Nodes<'_>, step: u64, t: f64) -> anyhow::Result<()> {
+    let stop = command(0.0, false, true);
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        link.send(step, t, stop.clone())?;
+    }
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        link.send(step, t, stop)?;
+    }
+    Ok(())
+}
+
+/// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state,
+/// ends `unstable`: the node blew up without noticing), naming the message, the field, the index and the value.
+fn unusable(node: &str, e: Invalid) -> LinkError {
+    let (node, message) = (node.to_string(), format!("sent an unusable message: {e}"));
+    if e.is_non_finite() {
+        LinkError::Unstable { node, message }
+    } else {
+        LinkError::Failed { node, message }
+    }
+}

@@ -1,0 +1,169 @@
+//! The step coordinator (`DESIGN.md` §3): fixes each coupling step, holds the step barrier, runs the contact pass,
+//! samples probes and writes the outputs. It talks to the solvers only through [`crate::link::NodeLink`], so it
+//! runs the same in-process and distributed.
+//!
+//! The step loop is `drive`, written as its sequence of named steps; each step is a file here:
+//! `step_time.rs` (how long the step is, and the output times it lands on), `exchange.rs` (the commands out and
+//! the answers in, checked), `contact_pass.rs` (contact on the states just reported), `sampling.rs` (probes and
+//! frames at the output times), `progress.rs` (the report to whoever runs it, who may stop it) and
+//! `checkpointing.rs` (checkpoints between two steps, and continuing from one).
+
+use std::path::Path;
+use std::time::Instant;
+
+use cosim_proto::run_status::RunStatus;
+use cosim_proto::scene::LoadedScene;
+
+use crate::link::LinkError;
+use crate::summary::{Summary, SummaryBuilder};
+
+mod checkpointing;
+mod contact_pass;
+mod exchange;
+mod inputs;
+mod progress;
+mod sampling;
+mod step_time;
+
+use checkpointing::{RunState, Schedule};
+use contact_pass::ContactPass;
+use exchange::check_registrations;
+pub use inputs::{Checkpoints, Nodes, RunInfo};
+pub use progress::{Control, Progress};
+use sampling::{Outputs, Series};
+use step_time::Clock;
+
+/// A finished run: its summary (also written to `summary.json`) and the error that ended it, if any.
+pub struct Outcome {
+    /// The summary.
+    pub summary: Summary,
+    /// Set when the run did not finish.
+    pub error: Option<anyhow::Error>,
+}
+
+/// Run a scene to its end time (or to the first failure) and write every output.
+pub fn run(
+    scene: &LoadedScene,
+    nodes: Nodes<'_>,
+    info: &RunInfo,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Outcome {
+    run_with(scene, nodes, info, &Checkpoints::default(), progress)
+}
+
+/// [`run`], writing checkpoints or continuing from one.
+pub fn run_with(
+    scene: &LoadedScene,
+    mut nodes: Nodes<'_>,
+    info: &RunInfo,
+    plan: &Checkpoints,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Outcome {
+    let started = Instant::now();
+    let (fem_nodes, fem_elements) = nodes
+        .fem
+        .as_ref()
+        .map_or((0, 0), |f| (f.setup().nodes.len() as u64, f.setup().cells.len() as u64));
+    let particles = nodes.sph.as_ref().map_or(0, |n| u64::from(n.setup().particles));
+    let mut summary = SummaryBuilder::new(&info.run_id, &info.mode)
+        .scene(&scene.scene)
+        .sizes(particles, fem_nodes, fem_elements)
+        .running();
+    let mut series = Vec::new();
+    let error = drive(scene, &mut nodes, info, plan, progress, &mut summary, &mut series).err();
+    if error.is_some() {
+        // What the nodes still alive counted up to the failure (a finished run asked them before its stop).
+        collect_counts(&mut nodes, &mut summary);
+    }
+    // Whatever happened, the probes computed so far are plotted and the summary is written.
+    let t_plot = Instant::now();
+    if let Err(e) = sampling::plot_all(scene, &info.out, &series) {
+        tracing::warn!("plots: {e:#}");
+    }
+    summary.timings.broker += t_plot.elapsed().as_secs_f64();
+    let failure = error.as_ref().map(|e| {
+        let status = e
+            .downcast_ref::<LinkError>()
+            .map_or(RunStatus::Failed, LinkError::status);
+        (status, format!("{e:#}").replace('\n', " "))
+    });
+    summary.end(failure, started.elapsed().as_secs_f64());
+    if let Err(e) = write_summary(&info.out, &summary) {
+        tracing::error!("{e:#}");
+    }
+    Outcome { summary, error }
+}
+
+/// The run from its first command to its last: the step loop (`DESIGN.md` §3).
+fn drive(
+    scene: &LoadedScene,
+    nodes: &mut Nodes<'_>,
+    info: &RunInfo,
+    plan: &Checkpoints,
+    progress: &mut dyn FnMut(Progress) -> Control,
+    summary: &mut Summary,
+    series: &mut Series,
+) -> anyhow::Result<()> {
+    let s = &scene.scene;
+    check_registrations(nodes)?;
+    let interface_ids = nodes
+        .fem
+        .as_ref()
+        .map_or_else(Vec::new, |f| f.setup().interface_nodes());
+    let mut outputs = Outputs::open(scene, nodes, &info.out, plan.restart.as_ref(), series)?;
+    let mut contact = ContactPass::new(s, nodes)?;
+    let dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
+    let mut clock = Clock::new(s, nodes.fem.is_some(), dt_fluid);
+    let mut checkpoints = Schedule::new(plan.interval);
+    match &plan.restart {
+        Some(saved) => checkpointing::resume(saved, &mut checkpoints, &mut clock, &mut contact, &mut outputs, summary)?,
+        // The first sample, at t = 0.
+        None => {
+            let commands = contact.commands(0.0, true);
+            let mut round = exchange::exchange(nodes, &interface_ids, summary, 0, 0.0, commands)?;
+            outputs.sample(0.0, &mut round, nodes, contact.load.as_deref(), summary)?;
+        }
+    }
+    while clock.running() {
+        // §3 step 1: how long this step is, and whether it lands on an output time.
+        let step = clock.next_step();
+        // §3 steps 2–3: the commands out (with the last pass's corrections), the states in.
+        let commands = contact.commands(step.dt, step.lands);
+        let mut round = exchange::exchange(nodes, &interface_ids, summary, clock.step, clock.t, commands)?;
+        clock.advance(&step, &round, summary);
+        // §3 step 4: contact on the states just reported; the corrections go out with the next command.
+        contact.pass(&round, &step, clock.step, clock.t, summary)?;
+        // §5: probes and frames at an output time.
+        if step.lands {
+            outputs.sample(clock.t, &mut round, nodes, contact.load.as_deref(), summary)?;
+            clock.sampled(&step);
+        }
+        progress::report(progress, &clock, &contact, summary)?;
+        let state = RunState {
+            clock: &clock,
+            contact: &contact,
+            outputs: &outputs,
+            summary,
+        };
+        checkpointing::save_if_due(&mut checkpoints, &step, state, scene, nodes, info)?;
+    }
+    collect_counts(nodes, summary);
+    exchange::stop(nodes, clock.step + 1, clock.t)?;
+    outputs.finish(summary)
+}
+
+/// Each node's counts into the summary (`Summary::counts`), for the nodes that can say.
+fn collect_counts(nodes: &mut Nodes<'_>, summary: &mut Summary) {
+    if let Some(counts) = nodes.fem.as_deref_mut().and_then(|l| l.counts()) {
+        summary.counts.insert("fem-node".into(), counts);
+    }
+    if let Some(counts) = nodes.sph.as_deref_mut().and_then(|l| l.counts()) {
+        summary.counts.insert("sph-node".into(), counts);
+    }
+}
+
+/// Write `summary.json` in place over the room reserved for it when the run started (`crate::summary`), so that
+/// it is written however full the disk got; an error names the file.
+pub fn write_summary(out: &Path, summary: &Summary) -> anyhow::Result<()> {
+    Ok(crate::summary::write(out, summary)?)
+}
