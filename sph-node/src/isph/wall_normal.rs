@@ -3,9 +3,10 @@
 //! The corrector u^{n+1} = u* − Δt ∇p/ρ stops the motion into a wall when ∂p/∂n = ρ u* · n / Δt there (Cummins &
 //! Rudman 1999, the Neumann condition of the projection; `DESIGN.md` §4.3). With u* = uⁿ + Δt (g + ν∇²uⁿ) this is
 //! the Adami et al. 2012 extrapolation, Eq. (27), whose g · r_wf term is the gravity part, plus the part of the
-//! fluid's own motion, ρ (ũ_f · n)(r_wf · n)/Δt with ũ_f = u*_f − Δt g. Both sit in the wall rows of the PPE, so both
-//! act on every fluid particle next to a wall, also on one whose own row is Dirichlet (a free-surface particle at a
-//! wall) or whose pressure is clipped to 0.
+//! fluid's own motion, ρ (ũ_f · n)(r_wf · n)/Δt with ũ_f = u*_f − Δt g, taken from the fluid in contact with the wall
+//! only ([`normal_motion_term`]). Both sit in the wall rows of the PPE, so both act on every fluid particle next to
+//! a wall, also on one whose own row is Dirichlet (a free-surface particle at a wall) or whose pressure is clipped
+//! to 0.
 //!
 //! The flux through the wall is then imposed once, by the wall rows: in ∇·u* a wall particle carries Δt g plus the
 //! normal part of the fluid's motion next to it, (ũ_w · n) n with ũ_w = Σ_f ũ_f W_wf / Σ_f W_wf (the Shepard
