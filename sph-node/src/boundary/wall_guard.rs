@@ -63,6 +63,16 @@ impl WallBoxes {
         (n > 0.0).then(|| [d[0] / n, d[1] / n])
     }
 
+    /// The distance from `x` to the nearest point outside every box (how deep a wall particle sits behind the face;
+    /// 0 outside the walls).
+    pub fn depth(&self, x: [f64; 2]) -> f64 {
+        let (mut y, mut v) = (x, [0.0; 2]);
+        if !self.push_out(&mut y, &mut v) {
+            return 0.0;
+        }
+        (y[0] - x[0]).hypot(y[1] - x[1])
+    }
+
     /// The displacement `d` of a particle at `x` (outside the walls), with the part that would take it nearer than
     /// `gap` to a wall box taken off along the box's normal (from its nearest point to `x`), box by box: a particle
     /// already nearer keeps no motion towards that box; motion along or away from the faces is kept.

@@ -192,7 +192,7 @@ pub fn fluid_row(
 
 /// Row of wall particle w (a `view` index ≥ `n_fluid`) and its right-hand side: Adami et al. 2012, Eq. (27), with
 /// the normal motion of the fluid ([`super::wall_normal`]; `view.v` holds u* of the fluid, `normal` is w's normal,
-/// `dt` the step).
+/// `touch` its depth behind the face plus Δx/2 ([`wall_normal::normal_motion_term`]), `dt` the step).
 #[allow(clippy::too_many_arguments)]
 pub fn wall_row(
     w: usize,
@@ -201,6 +201,7 @@ pub fn wall_row(
     kernel: &CubicSpline,
     gravity: [f64; 2],
     normal: [f64; 2],
+    touch: f64,
     dt: f64,
     row: &mut RowSink<'_>,
 ) -> f64 {
@@ -217,7 +218,7 @@ pub fn wall_row(
         sum_w += wgt;
         sum_rho_r[0] += view.rho[f] * r_wf[0] * wgt;
         sum_rho_r[1] += view.rho[f] * r_wf[1] * wgt;
-        sum_motion += wall_normal::normal_motion_term(view.rho[f], view.v[f], r_wf, normal, dt, gravity) * wgt;
+        sum_motion += wall_normal::normal_motion_term(view.rho[f], view.v[f], r_wf, normal, touch, dt, gravity) * wgt;
         row.push(f as u32, wgt);
     }
     if sum_w <= 0.0 {
@@ -235,8 +236,8 @@ pub fn wall_row(
 }
 
 /// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags), `contact`
-/// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` (one per wall particle,
-/// see [`super::wall_normal`]) and the step `dt` in. `view.v` holds u* of the
+/// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` and `touch` distances
+/// (one per wall particle, see [`super::wall_normal`]) and the step `dt` in. `view.v` holds u* of the
 /// fluid. `full`: the diagonal of a full support ([`full_support_coefficient`]) for the void rows of
 /// [`fluid_row`]. The matrix goes into `a` and the right-hand side into `b`, reusing their allocations.
 #[allow(clippy::too_many_arguments)]
@@ -250,6 +251,7 @@ pub fn assemble(
     contact: &[bool],
     sources: &[f64],
     normals: &[[f64; 2]],
+    touch: &[f64],
     dt: f64,
     full: f64,
     a: &mut SparseRows,
@@ -269,7 +271,8 @@ pub fn assemble(
             fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic, full, row)
         } else {
             let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
-            wall_row(i, view, list.of(i), kernel, gravity, normal, dt, row)
+            let touch = touch.get(i - view.n_fluid).copied().unwrap_or(0.0);
+            wall_row(i, view, list.of(i), kernel, gravity, normal, touch, dt, row)
         }
     });
 }

@@ -306,6 +306,13 @@ impl IsphSolver {
             &in_contact,
             &source,
             &self.wall_normals,
+            // Where a fluid particle touches each wall's face (`wall_normal::normal_motion_term`); walls do not move.
+            &self
+                .walls
+                .x
+                .iter()
+                .map(|&x| self.wall_boxes.depth(x) + 0.5 * self.params.dx)
+                .collect::<Vec<_>>(),
             dt,
             // The void that cuts a support counts as p = 0 beyond `ppe::VOID_TOLERANCE` of a full support
             // (`ppe::fluid_row`). Computed here, not stored: the checkpoint format stays as it is.
