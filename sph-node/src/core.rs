@@ -185,7 +185,7 @@ impl SphCore {
         while done < cmd.dt {
             let (stable, left) = (self.solver.stable_dt(), cmd.dt - done);
             let mut h = stable.min(left);
-            if matches!(self.solver, Fluid::Isph(_)) && left > stable {
+            if self.solver.equal_substeps() && left > stable {
                 // ISPH: equal sub-steps, not full steps and a remainder. Its pressure carries 1/Δt (the PPE source
                 // ∇·u*/Δt and the walls' Neumann rows ρ u*·n/Δt: the impulse Δt ∇p/ρ is what the projection
                 // fixes), so a remainder step multiplies it by Δt_own/Δt: the Lobovsky dam break at H/30 took

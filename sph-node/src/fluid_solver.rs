@@ -33,6 +33,11 @@ pub trait FluidSolver: Send + Sync {
     /// Stable step of the current state.
     fn stable_dt(&self) -> f64;
 
+    /// Whether a coupling step longer than the stable step is cut into equal sub-steps rather than full steps and
+    /// a remainder: a method whose pressure carries 1/Δt (ISPH) must not take a short remainder step.
+    fn equal_substeps(&self) -> bool {
+        false
+    }
     /// Advances the fluid by `dt`. After an error the state is part-way through the step and should not be
     /// advanced further.
     fn step(&mut self, dt: f64) -> Result<()>;

@@ -11,6 +11,12 @@ impl FluidSolver for IsphSolver {
         "isph"
     }
 
+    /// Its pressure carries 1/Δt (the PPE source ∇·u*/Δt, the walls' Neumann rows): a remainder step multiplies
+    /// it (`core.rs`, docs/CORRECTIONS.md "ISPH pressure").
+    fn equal_substeps(&self) -> bool {
+        true
+    }
+
     fn params(&self) -> &SphParams {
         IsphSolver::params(self)
     }
