@@ -136,6 +136,11 @@ impl Interface {
         ]
     }
 
+    /// The contact impulse of the last pass per FE node [N·s/m].
+    pub fn impulses(&self) -> &[[f64; 2]] {
+        &self.impulse
+    }
+
     /// The contact impulse of the last pass per FE node divided by its coupling step: the interface load [N/m].
     pub fn load(&self) -> Vec<[f64; 2]> {
         let k = if self.dt > 0.0 { 1.0 / self.dt } else { 0.0 };

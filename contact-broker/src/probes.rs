@@ -1,8 +1,9 @@
 //! Probes of `DESIGN.md` §5, evaluated on the nodes' snapshots at output times.
 
 use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
-use cosim_proto::scene::{EnergyOf, EnergyPart, ProbeKind, Scene};
-use sph_node::kernel::CubicSpline;
+use cosim_proto::scene::{Average, EnergyOf, EnergyPart, PressureSensor, ProbeKind, Scene};
+use serde::{Deserialize, Serialize};
+use sph_node::sensors::{sensor_pressure, PressureField};
 
 /// A probe resolved against the registered mesh and particles.
 #[derive(Clone, Debug)]
@@ -19,8 +20,49 @@ enum Resolved {
     Front { component: usize },
     /// Highest fluid particle with x ≤ x_max.
     Column { x_max: f64 },
-    /// Shepard-normalised SPH pressure at a point.
-    Pressure { point: [f64; 2] },
+    /// Shepard-normalised SPH pressure, the mean over a sensor's face, now.
+    Pressure { sensor: PressureSensor },
+    /// The same, its time mean over the sampling interval: the fluid node's interval sensor `index`.
+    PressureMean { index: usize },
+    /// The summed interface load of one solid or all, component `component`, over the sampling interval.
+    InterfaceLoad { solid: Option<usize>, component: usize },
+}
+
+/// The contact impulse the structure received since the last sample, per solid, and the time it took: what an
+/// `interface_load` probe reads (a checkpoint keeps it).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LoadLog {
+    /// Σ over the passes since the last sample of each solid's nodes' contact impulses [N s per unit thickness].
+    pub impulse: Vec<[f64; 2]>,
+    /// Σ Δt over those passes [s].
+    pub time: f64,
+}
+
+impl LoadLog {
+    /// Add one pass's impulses (`impulse[n]` on FE node n, of solid `node_solid[n]`) over a step `dt`.
+    pub fn add(&mut self, impulse: &[[f64; 2]], node_solid: &[u32], dt: f64) {
+        for (j, &solid) in impulse.iter().zip(node_solid) {
+            let solid = solid as usize;
+            if self.impulse.len() <= solid {
+                self.impulse.resize(solid + 1, [0.0; 2]);
+            }
+            self.impulse[solid][0] += j[0];
+            self.impulse[solid][1] += j[1];
+        }
+        self.time += dt;
+    }
+
+    /// The mean load of `solid` (all where `None`) along `component` since the last sample; NaN before any pass.
+    fn mean(&self, solid: Option<usize>, component: usize) -> f64 {
+        if self.time <= 0.0 {
+            return f64::NAN;
+        }
+        let total: f64 = match solid {
+            Some(s) => self.impulse.get(s).map_or(0.0, |j| j[component]),
+            None => self.impulse.iter().map(|j| j[component]).sum(),
+        };
+        total / self.time
+    }
 }
 
 /// All probes of a scene, resolved once.
@@ -59,6 +101,17 @@ impl Probes {
                 .map(|_| ())
                 .ok_or_else(|| format!("probe[{p}].kind: the run has no fluid node"))
         };
+        // The fluid node computes the interval means, in scene order (`PressureSensor::interval`); an outside node
+        // may offer none, and then cannot run a scene that asks for them.
+        let intervals = PressureSensor::interval(scene).len();
+        if let Some(setup) = fluid.filter(|s| s.sensors as usize != intervals) {
+            return Err(format!(
+                "probe: the scene has {intervals} pressure probes with average = \"interval\", the fluid node computes {} \
+                 interval sensors",
+                setup.sensors
+            ));
+        }
+        let mut interval = 0;
         for (p, spec) in scene.probes.iter().enumerate() {
             let missing = |k: &str| format!("probe[{p}].{k}: missing");
             resolved.push(match spec.kind {
@@ -88,11 +141,20 @@ impl Probes {
                     }
                 }
                 ProbeKind::Pressure => {
-                    need_fluid(p)?;
-                    Resolved::Pressure {
-                        point: spec.point.ok_or_else(|| missing("point"))?,
+                    let setup = fluid.ok_or_else(|| format!("probe[{p}].kind: the run has no fluid node"))?;
+                    spec.point.ok_or_else(|| missing("point"))?;
+                    let sensor = PressureSensor::of(scene, p, setup.spacing).ok_or_else(|| missing("point"))?;
+                    if spec.average == Some(Average::Interval) {
+                        interval += 1;
+                        Resolved::PressureMean { index: interval - 1 }
+                    } else {
+                        Resolved::Pressure { sensor }
                     }
                 }
+                ProbeKind::InterfaceLoad => Resolved::InterfaceLoad {
+                    solid: spec.solid.as_deref().map(|n| solid_index(p, n)).transpose()?,
+                    component: spec.component.ok_or_else(|| missing("component"))?.index(),
+                },
             });
         }
         Ok(Self {
@@ -108,11 +170,12 @@ impl Probes {
         &self.names
     }
 
-    /// Evaluate every probe on the snapshots of this output time.
+    /// Evaluate every probe on the snapshots of this output time and the load since the last one.
     pub fn sample(
         &mut self,
         fem: Option<(&FemMesh, &FemSnapshot)>,
         sph: Option<(&SphSetup, &SphSnapshot)>,
+        load: &LoadLog,
     ) -> Vec<f64> {
         if let (None, Some((_, snap))) = (&self.fluid_x0, sph) {
             self.fluid_x0 = Some(snap.x.clone());
@@ -146,7 +209,23 @@ impl Probes {
                         .reduce(f64::max)
                         .unwrap_or(f64::NAN)
                 }),
-                Resolved::Pressure { point } => sph.map_or(f64::NAN, |(setup, s)| pressure_at(setup, s, point)),
+                Resolved::Pressure { ref sensor } => sph.map_or(f64::NAN, |(setup, s)| {
+                    let field = PressureField {
+                        x: &s.x,
+                        m: &s.m,
+                        rho: &s.rho,
+                        p: &s.p,
+                        wall_x: &setup.walls,
+                        wall_p: &s.wall_p,
+                        h: setup.h,
+                        spacing: setup.spacing,
+                    };
+                    sensor_pressure(&field, sensor)
+                }),
+                Resolved::PressureMean { index } => {
+                    sph.map_or(f64::NAN, |(_, s)| s.sensors.get(index).copied().unwrap_or(f64::NAN))
+                }
+                Resolved::InterfaceLoad { solid, component } => load.mean(solid, component),
             })
             .collect()
     }
@@ -191,35 +270,6 @@ fn structure_energy(snap: &FemSnapshot, part: EnergyPart, solid: Option<usize>) 
         .sum()
 }
 
-/// Shepard-normalised SPH interpolation Σ p_j V_j W / Σ V_j W over fluid and wall particles (walls carry their
-/// extrapolated pressure and the lattice volume Δx²); NaN where no particle is within the kernel support.
-fn pressure_at(setup: &SphSetup, snap: &SphSnapshot, point: [f64; 2]) -> f64 {
-    let kernel = CubicSpline::new(setup.h);
-    let support2 = kernel.support() * kernel.support();
-    let wall_volume = setup.spacing * setup.spacing;
-    let fluid = snap
-        .x
-        .iter()
-        .zip(snap.m.iter().zip(&snap.rho))
-        .zip(&snap.p)
-        .map(|((x, (m, rho)), p)| (x, m / rho, p));
-    let walls = setup.walls.iter().zip(&snap.wall_p).map(|(x, p)| (x, wall_volume, p));
-    let (mut num, mut den) = (0.0, 0.0);
-    for (x, volume, p) in fluid.chain(walls) {
-        let r2 = (x[0] - point[0]).powi(2) + (x[1] - point[1]).powi(2);
-        if r2 < support2 {
-            let w = kernel.w(r2.sqrt()) * volume;
-            num += p * w;
-            den += w;
-        }
-    }
-    if den > 0.0 {
-        num / den
-    } else {
-        f64::NAN
-    }
-}
-
 /// The node of solid `solid` nearest `point` in the reference configuration; ties go to the lowest id.
 fn nearest_node(mesh: &FemMesh, solid: usize, point: [f64; 2]) -> Option<usize> {
     let d2 = |p: [f64; 2]| (p[0] - point[0]).powi(2) + (p[1] - point[1]).powi(2);
@@ -256,6 +306,7 @@ mod tests {
             density: 1000.0,
             walls: Vec::new(),
             dt_stable: 1e-4,
+            sensors: 0,
         };
         let snap = |x: Vec<[f64; 2]>| SphSnapshot {
             v: vec![[0.0; 2]; x.len()],
@@ -263,12 +314,21 @@ mod tests {
             p: vec![0.0; x.len()],
             m: vec![0.025; x.len()],
             wall_p: Vec::new(),
+            sensors: Vec::new(),
             x,
         };
         let mut probes = Probes::resolve(&scene, None, Some(&setup)).unwrap();
-        let full = probes.sample(None, Some((&setup, &snap(vec![[0.0025, 0.0975], [0.2, 0.01]]))));
+        let full = probes.sample(
+            None,
+            Some((&setup, &snap(vec![[0.0025, 0.0975], [0.2, 0.01]]))),
+            &LoadLog::default(),
+        );
         assert_eq!(full[column], 0.0975);
-        let empty = probes.sample(None, Some((&setup, &snap(vec![[0.3, 0.01], [0.2, 0.01]]))));
+        let empty = probes.sample(
+            None,
+            Some((&setup, &snap(vec![[0.3, 0.01], [0.2, 0.01]]))),
+            &LoadLog::default(),
+        );
         assert!(empty[column].is_nan(), "{}", empty[column]);
     }
 }

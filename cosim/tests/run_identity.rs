@@ -282,6 +282,7 @@ fn a_refused_registration_is_reported_with_its_reason() {
         density: 1000.0,
         walls: Vec::new(),
         dt_stable: 1e-4,
+        sensors: 0,
     };
     let mut bytes = Envelope::new(&id, 0, 0.0, setup).encode();
     bytes[0] = 7;

@@ -35,7 +35,7 @@ import tomllib
 
 import zenoh
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 
 
 # --- wire format (docs/PROTOCOL.md §3-§5) -------------------------------------------------------------------------

@@ -2,8 +2,9 @@
 
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
-/// Protocol version this build speaks.
-pub const PROTOCOL_VERSION: u32 = 1;
+/// Protocol version this build speaks. 2: `SphSetup::sensors` and `SphSnapshot::sensors` (interval-mean pressure
+/// sensors).
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// `{protocol_version, run, step, t, body}`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

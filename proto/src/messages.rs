@@ -145,6 +145,9 @@ pub struct SphSetup {
     pub walls: Vec<[f64; 2]>,
     /// Stable step of the initial state [s].
     pub dt_stable: f64,
+    /// Interval-mean pressure sensors the node computes: the scene's `pressure` probes with `average =
+    /// "interval"` (`cosim_proto::scene::PressureSensor::interval`), in scene order; 0 for a node that offers none.
+    pub sensors: u32,
 }
 
 /// A full fluid snapshot for frames and probes.
@@ -162,6 +165,10 @@ pub struct SphSnapshot {
     pub m: Vec<f64>,
     /// Wall particle pressures [Pa], in the order of [`SphSetup::walls`].
     pub wall_p: Vec<f64>,
+    /// Each interval sensor's time mean since the last snapshot [Pa] ([`SphSetup::sensors`] of them): Σ p_k Δt_k /
+    /// Σ Δt_k over the SPH steps k since then, p_k the mean over the sensor's face after step k; the value now
+    /// where no step was taken since. NaN where no particle is within reach of the face.
+    pub sensors: Vec<f64>,
 }
 
 /// Topic `sph/state` (sph → broker, each step).

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::SphError;
 use crate::fluid_solver::{FluidSolver, SavedSolver};
 use crate::isph::{IsphSolver, PpeSource};
+use crate::sensors::{IntervalSensors, PressureField, SensorLog};
 use crate::setup;
 use crate::stability::EnergyGuard;
 use crate::wcsph::WcsphSolver;
@@ -20,7 +21,7 @@ use crate::wcsph::WcsphSolver;
 /// solvers carry `fluid.cfl`; 3: the WCSPH solver carries its wall boxes and wall-guard count; 4: the neighbour lists
 /// keep only the ∇W factor per pair (no r², no W), and the WCSPH scratch has two per-particle buffers (was six); 6: the
 /// WCSPH options carry the δ-SPH density diffusion; 7: state only ([`SphCheckpoint`]: no parameters, neighbour lists
-/// or scratch, which the scene and the restore rebuild).
+/// or scratch, which the scene and the restore rebuild), with the interval sensors' log.
 pub const CHECKPOINT_TAG: (&str, u32) = ("cosim-sph-checkpoint", 7);
 
 /// What a fluid node's checkpoint holds after its tag and version: the solver's state and the energy guard's bound.
@@ -30,6 +31,8 @@ pub struct SphCheckpoint {
     pub solver: SavedSolver,
     /// The energy guard.
     pub guard: EnergyGuard,
+    /// The interval pressure sensors' integrals since the last snapshot.
+    pub sensors: SensorLog,
 }
 
 /// The solver of `fluid.solver`.
@@ -54,6 +57,8 @@ pub struct SphCore {
     guard: EnergyGuard,
     /// `coupling.max_dt`: no command may ask for a longer step.
     max_dt: f64,
+    /// The scene's interval-mean pressure sensors, logged after every step.
+    sensors: IntervalSensors,
 }
 
 impl SphCore {
@@ -68,6 +73,12 @@ impl SphCore {
             density: scene.fluid.as_ref().map_or(1000.0, |f| f.density),
             walls: solver.walls().x.clone(),
             dt_stable: solver.stable_dt(),
+            sensors: 0,
+        };
+        let sensors = IntervalSensors::new(scene);
+        let setup = SphSetup {
+            sensors: sensors.len() as u32,
+            ..setup
         };
         let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity);
         Ok(Self {
@@ -75,6 +86,7 @@ impl SphCore {
             setup,
             guard,
             max_dt: scene.coupling.max_dt,
+            sensors,
         })
     }
 
@@ -96,6 +108,7 @@ impl SphCore {
         let saved = SphCheckpoint {
             solver: self.solver.save(),
             guard: self.guard,
+            sensors: self.sensors.log().clone(),
         };
         bincode::serialize(&(tag.0, tag.1, &saved)).expect("in-memory bincode encoding of plain data")
     }
@@ -120,7 +133,7 @@ impl SphCore {
         }
         let (_, _, saved): (String, u32, SphCheckpoint) =
             options.reject_trailing_bytes().deserialize(data).map_err(not_ours)?;
-        let SphCheckpoint { solver, guard } = saved;
+        let SphCheckpoint { solver, guard, sensors } = saved;
         if solver.solver != self.solver.name() {
             return Err(invalid(format!(
                 "saved with fluid.solver = \"{}\", the scene has \"{}\"",
@@ -140,8 +153,11 @@ impl SphCore {
                 guard.bound, self.guard.bound
             )));
         }
+        let mut logged = self.sensors.clone();
+        logged.restore(sensors).map_err(invalid)?;
         self.solver.restore(solver).map_err(invalid)?;
         self.guard = guard;
+        self.sensors = logged;
         Ok(())
     }
 
@@ -198,6 +214,10 @@ impl SphCore {
                 h = cmd.dt - done;
             }
             self.solver.step(h)?;
+            if !self.sensors.is_empty() {
+                self.sensors
+                    .after_step(&pressure_field(self.solver.as_ref(), &self.setup), h);
+            }
             substeps += 1;
             done += h;
         }
@@ -223,6 +243,9 @@ impl SphCore {
             p: state.p.clone(),
             m: state.m.clone(),
             wall_p: self.solver.walls().p.clone(),
+            sensors: self
+                .sensors
+                .take_means(&pressure_field(self.solver.as_ref(), &self.setup)),
         });
         Ok(Some(SphState {
             ids,
@@ -234,5 +257,20 @@ impl SphCore {
             compute_seconds: started.elapsed().as_secs_f64(),
             snapshot,
         }))
+    }
+}
+
+/// What the pressure sensors read: the solver's particles and walls.
+fn pressure_field<'a>(solver: &'a dyn FluidSolver, setup: &SphSetup) -> PressureField<'a> {
+    let (state, walls) = (solver.state(), solver.walls());
+    PressureField {
+        x: &state.x,
+        m: &state.m,
+        rho: &state.rho,
+        p: &state.p,
+        wall_x: &walls.x,
+        wall_p: &walls.p,
+        h: setup.h,
+        spacing: setup.spacing,
     }
 }

@@ -34,6 +34,7 @@ pub mod node;
 pub mod params;
 pub mod particles;
 mod restore;
+pub mod sensors;
 pub mod setup;
 pub mod stability;
 pub mod time_step;

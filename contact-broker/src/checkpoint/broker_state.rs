@@ -8,6 +8,7 @@ use cosim_proto::messages::Correction;
 use cosim_proto::scene::Scene;
 use serde::{Deserialize, Serialize};
 
+use crate::probes::LoadLog;
 use crate::summary::Summary;
 
 /// The coordinator's state between two steps: what, with the nodes' states, makes the continued run the same.
@@ -31,6 +32,8 @@ pub struct BrokerState {
     pub roi: Option<[f64; 4]>,
     /// Interface load of the last output step.
     pub load: Option<Vec<[f64; 2]>>,
+    /// The contact impulse per solid since the last sample (`interface_load` probes).
+    pub load_log: LoadLog,
     /// Fluid particles exchanged over the run.
     pub exchanged: u64,
     /// Fluid positions of the first sample (potential energy probes).
@@ -119,6 +122,15 @@ impl BrokerState {
             if let Some(k) = load.iter().position(|l| !finite(l)) {
                 return Err(format!("load[{k}] = {:?} is not finite", load[k]));
             }
+        }
+        ensure(self.load_log.time >= 0.0 && self.load_log.time.is_finite(), || {
+            format!("load_log.time = {} is not a time", self.load_log.time)
+        })?;
+        if let Some(k) = self.load_log.impulse.iter().position(|j| !finite(j)) {
+            return Err(format!(
+                "load_log.impulse[{k}] = {:?} is not finite",
+                self.load_log.impulse[k]
+            ));
         }
         if let Some(x0) = &self.fluid_origin {
             ensure(x0.len() as u64 == particles, || {
@@ -245,6 +257,7 @@ component = "x"
             }],
             roi: Some([0.9, -0.1, 1.3, 0.2]),
             load: Some(vec![[0.0; 2]; 6]),
+            load_log: LoadLog::default(),
             exchanged: 40,
             fluid_origin: Some(vec![[0.05, 0.05]; 16]),
             rows: vec![(0.0, vec![0.4]), (0.1, vec![0.45]), (0.2, vec![0.5])],

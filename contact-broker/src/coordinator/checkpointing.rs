@@ -80,6 +80,7 @@ pub(super) fn save_if_due(
         pending_sph: contact.pending.sph.clone(),
         roi: contact.roi,
         load: contact.load.clone(),
+        load_log: contact.since.clone(),
         exchanged: contact.exchanged,
         fluid_origin: run.outputs.probes.fluid_origin().map(<[_]>::to_vec),
         rows: run.outputs.csv.rows().to_vec(),
@@ -132,6 +133,7 @@ pub(super) fn resume(
         sph: saved.pending_sph.clone(),
     };
     (contact.roi, contact.load, contact.exchanged) = (saved.roi, saved.load.clone(), saved.exchanged);
+    contact.since = saved.load_log.clone();
     outputs.resume(saved)?;
     summary.continue_from(&saved.summary);
     Ok(())

@@ -13,6 +13,7 @@ use super::exchange::{commands, Round};
 use super::inputs::Nodes;
 use super::step_time::Step;
 use crate::interface::{Corrections, Interface, PassStats};
+use crate::probes::LoadLog;
 use crate::summary::{ContactStats, Summary};
 
 /// The contact between the structure and the fluid, and what one pass leaves for the next step.
@@ -24,6 +25,10 @@ pub(super) struct ContactPass {
     pub roi: Option<[f64; 4]>,
     /// Interface load of the last output step.
     pub load: Option<Vec<[f64; 2]>>,
+    /// The contact impulse per solid since the last sample (`interface_load` probes).
+    pub since: LoadLog,
+    /// The solid of each FE node.
+    node_solid: Vec<u32>,
     /// Fluid particles exchanged over the run.
     pub exchanged: u64,
     /// What the last pass did.
@@ -47,6 +52,11 @@ impl ContactPass {
             pending: Corrections::default(),
             roi,
             load: None,
+            since: LoadLog::default(),
+            node_solid: nodes
+                .fem
+                .as_ref()
+                .map_or_else(Vec::new, |f| f.setup().node_solid.clone()),
             exchanged: 0,
             last: PassStats::default(),
         })
@@ -80,6 +90,7 @@ impl ContactPass {
         self.roi = Some(interface.roi(&fem.x));
         self.exchanged += stats.exchanged as u64;
         record(&mut summary.contact_stats, &stats, self.exchanged, number);
+        self.since.add(interface.impulses(), &self.node_solid, step.dt);
         if step.lands {
             self.load = Some(interface.load());
         }

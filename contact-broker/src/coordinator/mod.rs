@@ -121,7 +121,14 @@ fn drive(
         None => {
             let commands = contact.commands(0.0, true);
             let mut round = exchange::exchange(nodes, &interface_ids, summary, 0, 0.0, commands)?;
-            outputs.sample(0.0, &mut round, nodes, contact.load.as_deref(), summary)?;
+            outputs.sample(
+                0.0,
+                &mut round,
+                nodes,
+                contact.load.as_deref(),
+                &mut contact.since,
+                summary,
+            )?;
         }
     }
     while clock.running() {
@@ -135,7 +142,14 @@ fn drive(
         contact.pass(&round, &step, clock.step, clock.t, summary)?;
         // §5: probes and frames at an output time.
         if step.lands {
-            outputs.sample(clock.t, &mut round, nodes, contact.load.as_deref(), summary)?;
+            outputs.sample(
+                clock.t,
+                &mut round,
+                nodes,
+                contact.load.as_deref(),
+                &mut contact.since,
+                summary,
+            )?;
             clock.sampled(&step);
         }
         progress::report(progress, &clock, &contact, summary)?;

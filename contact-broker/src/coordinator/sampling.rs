@@ -14,7 +14,7 @@ use super::exchange::Round;
 use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
-use crate::probes::Probes;
+use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
 
 /// Probe values over time, per probe.
@@ -86,6 +86,7 @@ impl<'s> Outputs<'s> {
         round: &mut Round,
         nodes: &Nodes<'_>,
         load: Option<&[[f64; 2]]>,
+        since: &mut LoadLog,
         summary: &mut Summary,
     ) -> anyhow::Result<()> {
         let started = Instant::now();
@@ -97,7 +98,9 @@ impl<'s> Outputs<'s> {
             (Some(link), Some(state)) => Some((link.setup(), snapshot(state.snapshot.as_ref(), "sph-node")?)),
             _ => None,
         };
-        let values = self.probes.sample(fem, sph);
+        let values = self.probes.sample(fem, sph, since);
+        // The interface_load probes' interval starts again.
+        *since = LoadLog::default();
         self.csv.push(t, &values)?;
         self.push_series(t, &values);
         let index = summary.frames as usize;

@@ -6,6 +6,7 @@
 //! - `load.rs`: reading, `--set` overrides (`overrides.rs`) and serde errors with their full dotted key;
 //! - `validate.rs`: the checks of every value a solver relies on;
 //! - `grid.rs`: the FEM grid numbering of a solid;
+//! - `sensors.rs`: the pressure sensors a fluid node samples every step (interval-mean pressure probes);
 //! - [`sizing`]: counts and bytes of a run, estimated from the scene alone.
 //!
 //! Everything is re-exported here, so users name `cosim_proto::scene::Scene`, `cosim_proto::scene::parse`, ….
@@ -14,12 +15,14 @@ mod grid;
 mod load;
 mod overrides;
 mod schema;
+mod sensors;
 pub mod sizing;
 mod validate;
 
 pub use load::{load, parse, LoadedScene, SceneError};
 pub use schema::{
-    BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf, EnergyPart,
-    FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec, ReferenceSpec, RunSpec,
-    Scene, SolidSpec, ISPH_APD_DEFAULT, SCENE_VERSION, WCSPH_APD_DEFAULT,
+    Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf,
+    EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec,
+    ReferenceSpec, RunSpec, Scene, SolidSpec, ISPH_APD_DEFAULT, SCENE_VERSION, WCSPH_APD_DEFAULT,
 };
+pub use sensors::{face_mean as sensors_face_mean, PressureSensor};

@@ -282,6 +282,18 @@ impl Scene {
                 ProbeKind::Energy => {
                     check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
                 }
+                ProbeKind::InterfaceLoad => {
+                    check(
+                        !self.solids.is_empty() && self.fluid.is_some(),
+                        || key("kind"),
+                        || "needs a [[solid]] and a [fluid] in the scene".into(),
+                    )?;
+                    check(
+                        probe.component.is_some(),
+                        || key("component"),
+                        || "missing key (interface_load)".into(),
+                    )?;
+                }
                 ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure => {
                     check(
                         self.fluid.is_some(),
@@ -318,6 +330,34 @@ impl Scene {
                         )?;
                     }
                 }
+            }
+            // A sensor's face and time mean (pressure probes only).
+            for (k, present) in [
+                ("radius", probe.radius.is_some()),
+                ("normal", probe.normal.is_some()),
+                ("average", probe.average.is_some()),
+            ] {
+                check(
+                    !present || probe.kind == ProbeKind::Pressure,
+                    || key(k),
+                    || "only a pressure probe takes this key".into(),
+                )?;
+            }
+            if let Some(r) = probe.radius {
+                check(
+                    r.is_finite() && r >= 0.0,
+                    || key("radius"),
+                    || format!("must be a finite length >= 0, got {r}"),
+                )?;
+                let n = probe.normal.unwrap_or([0.0, 0.0]);
+                check(
+                    r == 0.0 || (finite(&n) && n[0].hypot(n[1]) > 0.0),
+                    || key("normal"),
+                    || match probe.normal {
+                        None => "missing key (a face with radius > 0 needs the normal it lies across)".into(),
+                        Some(n) => format!("must be a finite non-zero vector, got {n:?}"),
+                    },
+                )?;
             }
             if let Some(r) = &probe.reference {
                 finite_positive(&key("reference.scale"), r.scale.abs())?;

@@ -331,6 +331,13 @@ impl SphSnapshot {
             c.len(field, len, n, "fluid particle")?;
         }
         c.len("wall_p", self.wall_p.len(), setup.walls.len(), "wall particle")?;
+        c.len("sensors", self.sensors.len(), setup.sensors as usize, "interval sensor")?;
+        for (k, v) in self.sensors.iter().enumerate() {
+            // NaN: no particle near the sensor (a point out of the water and the walls), as an instant probe says.
+            if v.is_infinite() {
+                return Err(c.fail("sensors", &[k], format!("{v}"), "not a number"));
+            }
+        }
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
         c.values("p", &self.p)?;

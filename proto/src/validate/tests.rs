@@ -121,6 +121,7 @@ fn fluid_ids_must_be_in_range_ascending_and_once() {
         density: 1000.0,
         walls: vec![],
         dt_stable: 1e-4,
+        sensors: 0,
     };
     let asked = Asked {
         interface: true,

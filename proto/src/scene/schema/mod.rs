@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 pub use contact::{ContactAlgorithm, ContactSpec};
 pub use coupling::CouplingSpec;
 pub use fluid::{DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, WCSPH_APD_DEFAULT};
-pub use probe::{Component, EnergyOf, EnergyPart, ProbeKind, ProbeSpec, ReferenceSpec};
+pub use probe::{Average, Component, EnergyOf, EnergyPart, ProbeKind, ProbeSpec, ReferenceSpec};
 pub use solid::{ElementKind, MaterialModel, MaterialSpec, SolidSpec};
 
 /// The scene format version this build reads.

@@ -15,8 +15,26 @@ pub enum ProbeKind {
     SurgeFront,
     /// Highest fluid particle among those with x ≤ `x_max` (the residual column of a dam break).
     ColumnHeight,
-    /// SPH-interpolated pressure at `point`.
+    /// SPH-interpolated pressure at `point`; optionally the mean over a sensor face (`radius`, `normal`) and over
+    /// the sampling interval (`average = "interval"`).
     Pressure,
+    /// The load the fluid puts on the structure through the contact (the sum of every interface node's contact
+    /// impulse, `interface_load` in the frames), `component` x or y, of `solid` (default every solid): the mean
+    /// over the sampling interval, total impulse since the last sample divided by the time since it [N per unit
+    /// thickness].
+    InterfaceLoad,
+}
+
+/// What a pressure probe's sample stands for in time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Average {
+    /// The value at the output time (the raw value).
+    #[default]
+    None,
+    /// The time mean over the sampling interval: every SPH step's value since the last sample weighted by its
+    /// step, as a sensor of finite bandwidth integrates (the fluid node computes it, `docs/PROTOCOL.md` §7).
+    Interval,
 }
 
 /// Which bodies an energy probe sums over.
@@ -88,6 +106,17 @@ pub struct ProbeSpec {
     /// Bodies an energy probe covers (energy; default all).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub of: Option<EnergyOf>,
+    /// Half the width of a pressure sensor's face [m] (pressure; default 0, a point): the sample is the mean of the
+    /// pressure at points spread over the face, a quarter spacing apart.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// The sensor face's outward normal, pointing into the fluid (pressure, with a `radius` > 0); the face lies
+    /// across it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 2]>,
+    /// `none` (default): the value at the output time; `interval`: its time mean since the last sample (pressure).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub average: Option<Average>,
     /// Column probes look at particles with x ≤ x_max (column_height).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub x_max: Option<f64>,
