@@ -31,7 +31,7 @@ run dam_wcsph_proc       dam_break          proc  --set run.end_time=0.06 --set 
 run dam_isph             dam_break          in    --set run.end_time=0.06 --set fluid.spacing=0.01 --set fluid.solver=isph --checkpoint-interval 0.02
 run dam_delta            dam_break          in    --set run.end_time=0.06 --set fluid.spacing=0.01 --set fluid.density_diffusion=0.1 --set fluid.density_filter=none
 run dam_mls              dam_break          in    --set run.end_time=0.06 --set fluid.spacing=0.01 --set fluid.density_filter=mls --set fluid.apd=0
-run plate                hydrostatic_plate  in    --set run.end_time=0.02 --checkpoint-interval 0.01
+run plate                hydrostatic_plate  in    --set run.end_time=0.02 --checkpoint-interval 0.0073
 run plate_isph           hydrostatic_plate  in    --set run.end_time=0.02 --set fluid.solver=isph
 run gate                 elastic_gate       in    --set run.end_time=0.02 --set fluid.spacing=0.004 --checkpoint-interval 0.01
 run gate_proc            elastic_gate       proc  --set run.end_time=0.02 --set fluid.spacing=0.004 --checkpoint-interval 0.01
@@ -40,6 +40,8 @@ run gate_none            elastic_gate       in    --set run.end_time=0.02 --set 
 run gate_isph            elastic_gate       in    --set run.end_time=0.02 --set fluid.spacing=0.004 --set fluid.solver=isph --checkpoint-interval 0.01
 run obstacle             elastic_obstacle   in    --set run.end_time=0.02 --checkpoint-interval 0.01
 run bench5000            bench_5000         in    --set run.end_time=0.05
+run lobovsky             lobovsky_dam_break in    --set run.end_time=0.03 --set fluid.spacing=0.02 --set coupling.max_dt=2.5e-4 --checkpoint-interval 0.0105
+run lobovsky_isph        lobovsky_dam_break in    --set run.end_time=0.03 --set fluid.spacing=0.02 --set fluid.solver=isph --set coupling.max_dt=2.5e-4 --checkpoint-interval 0.0105
 
 # Restarts from a middle checkpoint, to the same end: their probes and frames must equal the uninterrupted runs'.
 restart() { # name from_case scene mode [--set ...]
@@ -54,6 +56,8 @@ restart gate_restart       gate       elastic_gate      in   --set run.end_time=
 restart gate_proc_restart  gate_proc  elastic_gate      proc --set run.end_time=0.02 --set fluid.spacing=0.004
 restart gate_isph_restart  gate_isph  elastic_gate      in   --set run.end_time=0.02 --set fluid.spacing=0.004 --set fluid.solver=isph
 restart obstacle_restart   obstacle   elastic_obstacle  in   --set run.end_time=0.02
+restart lobovsky_restart   lobovsky   lobovsky_dam_break in  --set run.end_time=0.03 --set fluid.spacing=0.02 --set coupling.max_dt=2.5e-4
+restart lobovsky_isph_restart lobovsky_isph lobovsky_dam_break in --set run.end_time=0.03 --set fluid.spacing=0.02 --set fluid.solver=isph --set coupling.max_dt=2.5e-4
 
 cd "$out"
 find . -type f ! -name '*.log' | sort | while read -r f; do

@@ -79,6 +79,42 @@ fn a_column_probe_left_of_the_water_is_refused() {
     assert!(parse("f.toml", &text, &[format!("probe[{p}].x_max={first}")]).is_ok());
 }
 
+/// A sensor's face and time mean are pressure-probe keys; a face needs the normal it lies across.
+#[test]
+fn sensor_keys_are_checked_by_name() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/lobovsky_dam_break.toml"
+    ))
+    .unwrap();
+    let scene = parse("f.toml", &text, &[]).unwrap();
+    let p = scene.probes.iter().position(|p| p.name == "p_sensor1").unwrap();
+    let front = scene.probes.iter().position(|p| p.name == "surge_front").unwrap();
+    assert_eq!(
+        err(&text, &[&format!("probe[{front}].average=interval")]),
+        format!("f.toml: probe[{front}].average: only a pressure probe takes this key")
+    );
+    assert_eq!(
+        err(&text, &[&format!("probe[{p}].radius=0.002")]),
+        format!("f.toml: probe[{p}].normal: missing key (a face with radius > 0 needs the normal it lies across)")
+    );
+    assert_eq!(
+        err(&text, &[&format!("probe[{p}].radius=-0.002")]),
+        format!("f.toml: probe[{p}].radius: must be a finite length >= 0, got -0.002")
+    );
+    assert!(err(&text, &[&format!("probe[{p}].average=sometimes")]).contains("unknown variant `sometimes`"));
+    let ok = [
+        format!("probe[{p}].radius=0.002"),
+        format!("probe[{p}].normal=[-1.0, 0.0]"),
+    ];
+    assert!(parse("f.toml", &text, &ok).is_ok());
+    // An interface load needs a structure (the dam break has none).
+    assert_eq!(
+        err(&text, &[&format!("probe[{front}].kind=interface_load")]),
+        format!("f.toml: probe[{front}].kind: needs a [[solid]] and a [fluid] in the scene")
+    );
+}
+
 #[test]
 fn resolved_scene_round_trips_through_toml() {
     let s = parse("f.toml", SCENE, &["run.end_time=0.5".into()]).unwrap();
