@@ -66,7 +66,7 @@ fn another_protocol_version_is_refused_with_version() {
         matches!(err, CodecError::Version { what: "test", got } if got == PROTOCOL_VERSION + 1),
         "{err:?}"
     );
-    assert!(err.to_string().contains("protocol version 2"), "{err}");
+    assert!(err.to_string().contains("protocol version 3"), "{err}");
 }
 
 #[test]
@@ -83,12 +83,12 @@ fn another_version_is_reported_even_when_the_body_does_not_decode() {
         },
     )
     .encode();
-    bytes[0] = 2;
+    bytes[0] = 3;
     let err = Envelope::<StepCommand>::decode(&bytes, "r1", "test").unwrap_err();
-    assert!(matches!(err, CodecError::Version { got: 2, .. }), "{err:?}");
+    assert!(matches!(err, CodecError::Version { got: 3, .. }), "{err:?}");
     // Version is checked before the run.
     let err = Envelope::<StepCommand>::decode(&bytes, "other", "test").unwrap_err();
-    assert!(matches!(err, CodecError::Version { got: 2, .. }), "{err:?}");
+    assert!(matches!(err, CodecError::Version { got: 3, .. }), "{err:?}");
 }
 
 #[test]

@@ -55,7 +55,7 @@ where
 
 /// The worked example of `docs/PROTOCOL.md` §6: the same hex, line for line.
 const STEP_COMMAND_DOC_EXAMPLE: &str = "
-    01 00 00 00                         # protocol_version u32 = 1
+    02 00 00 00                         # protocol_version u32 = 2
     02 00 00 00 00 00 00 00             # run: length u64 = 2
     72 31                               #      UTF-8 \"r1\"
     03 00 00 00 00 00 00 00             # step u64 = 3
@@ -94,9 +94,9 @@ fn step_command_doc_example() -> Envelope<StepCommand> {
 }
 
 #[test]
-fn protocol_version_is_1() {
-    // Every golden string below starts with `01 00 00 00`; bumping the version must revisit them all.
-    assert_eq!(PROTOCOL_VERSION, 1);
+fn protocol_version_is_2() {
+    // Every golden string below starts with `02 00 00 00`; bumping the version must revisit them all.
+    assert_eq!(PROTOCOL_VERSION, 2);
 }
 
 #[test]
@@ -154,7 +154,7 @@ fn step_command_with_roi_and_stop_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         09 00 00 00 00 00 00 00         # step = 9
         00 00 00 00 00 00 f0 3f         # t = 1.0
@@ -194,7 +194,7 @@ fn fem_mesh_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         00 00 00 00 00 00 00 00         # step = 0
         00 00 00 00 00 00 00 00         # t = 0.0
@@ -246,7 +246,7 @@ fn fem_state_without_snapshot_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         03 00 00 00 00 00 00 00         # step = 3
         00 00 00 00 00 00 e4 3f         # t = 0.625
@@ -292,7 +292,7 @@ fn fem_state_with_snapshot_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         04 00 00 00 00 00 00 00         # step = 4
         00 00 00 00 00 00 f0 3f         # t = 1.0
@@ -333,7 +333,7 @@ fn node_checkpoint_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         07 00 00 00 00 00 00 00         # step = 7
         00 00 00 00 00 00 e0 3f         # t = 0.5
@@ -359,7 +359,7 @@ fn node_error_golden() {
     check_golden(
         &env,
         "
-        01 00 00 00                     # protocol_version = 1
+        02 00 00 00                     # protocol_version = 2
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         05 00 00 00 00 00 00 00         # step = 5
         00 00 00 00 00 00 e0 3f         # t = 0.5
@@ -386,7 +386,7 @@ fn run_id_bytes_are_utf8_with_u64_length() {
     check_golden(
         &env,
         "
-        01 00 00 00
+        02 00 00 00
         07 00 00 00 00 00 00 00  72 75 6e 2d 41 5f 37    # \"run-A_7\"
         01 00 00 00 00 00 00 00
         00 00 00 00 00 00 00 00

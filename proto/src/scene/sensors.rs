@@ -64,36 +64,36 @@ pub fn face_mean(values: impl ExactSizeIterator<Item = f64>) -> f64 {
 mod tests {
     use super::*;
 
-    fn scene(probe: &str) -> Scene {
-        let text = format!(
-            "version = 1\n[run]\nname = \"s\"\nend_time = 0.1\n[fluid]\nspacing = 0.01\n[[fluid.block]]\n\
-             min = [0.0, 0.0]\nmax = [0.5, 0.3]\n[[probe]]\nname = \"p\"\nkind = \"pressure\"\n{probe}\n"
-        );
-        crate::scene::parse("s.toml", &text, &[]).expect("scene")
+    /// The shipped Lobovsky scene (Δx = 0.01 m): probes 0 and 1 are interval sensors, 2 and 3 their instantaneous
+    /// twins, at x = 1.605 m, y = 3 and 15 mm.
+    fn lobovsky(sets: &[&str]) -> Scene {
+        let text = include_str!("../../../scenes/lobovsky_dam_break.toml");
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        crate::scene::parse("lobovsky_dam_break.toml", text, &sets).expect("the shipped scene")
     }
 
     #[test]
     fn a_face_spans_its_width_across_the_normal_a_quarter_spacing_apart() {
-        let s = scene("point = [1.0, 0.01]\nradius = 0.005\nnormal = [-1.0, 0.0]\naverage = \"interval\"");
-        let face = PressureSensor::interval(&s);
-        assert_eq!(face.len(), 1);
-        let y: Vec<f64> = face[0].points.iter().map(|p| p[1]).collect();
-        // radius 5 mm, quarter spacing 2.5 mm: 5 points from y = 0.015 down to 0.005 (tangent of −x is −y).
-        assert_eq!(y.len(), 5);
-        for (got, want) in y.iter().zip([0.015, 0.0125, 0.01, 0.0075, 0.005]) {
+        let s = lobovsky(&["probe[0].radius=0.005", "probe[0].normal=[-2.0, 0.0]"]);
+        let faces = PressureSensor::interval(&s);
+        assert_eq!(faces.iter().map(|f| f.probe).collect::<Vec<_>>(), vec![0, 1]);
+        let y: Vec<f64> = faces[0].points.iter().map(|p| p[1]).collect();
+        // radius 5 mm, quarter spacing 2.5 mm: 5 points from y = 0.008 down to −0.002 (the tangent of −x is −y).
+        assert_eq!(y.len(), 5, "{y:?}");
+        for (got, want) in y.iter().zip([0.008, 0.0055, 0.003, 0.0005, -0.002]) {
             assert!((got - want).abs() < 1e-15, "{y:?}");
         }
-        assert!(face[0].points.iter().all(|p| p[0] == 1.0));
+        assert!(faces[0].points.iter().all(|p| p[0] == 1.605));
+        assert_eq!(faces[1].points, vec![[1.605, 0.015]]);
     }
 
     #[test]
     fn a_point_sensor_is_its_point_and_not_in_the_interval_list_unless_asked() {
-        let s = scene("point = [1.0, 0.01]");
-        assert!(PressureSensor::interval(&s).is_empty());
-        assert_eq!(
-            PressureSensor::of(&s, 0, 0.01).expect("pressure").points,
-            vec![[1.0, 0.01]]
-        );
+        let s = lobovsky(&[]);
+        assert_eq!(PressureSensor::of(&s, 2, 0.01).expect("pressure").points, vec![[1.605, 0.003]]);
+        assert!(PressureSensor::of(&s, 4, 0.01).is_none(), "surge_front is not a pressure probe");
+        let none = lobovsky(&["probe[0].average=none", "probe[1].average=none"]);
+        assert!(PressureSensor::interval(&none).is_empty());
         assert_eq!(face_mean([3.25].into_iter()), 3.25);
     }
 }
