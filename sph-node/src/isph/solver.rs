@@ -12,7 +12,7 @@
 //!
 //! The fluid is incompressible: ρ = ρ0 for fluid and walls throughout.
 
-use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
+use cosim_proto::scene::{ContactAlgorithm, FluidSolver as SceneSolver, Scene};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -104,6 +104,11 @@ pub struct IsphSolver {
     cfl: f64,
     /// APD β (`fluid.apd`, §4.4; 0 disables): the particle shift applied after each step, as for WCSPH.
     apd: f64,
+    /// c0 of the scene (`fluid.sound_speed`, else its WCSPH default) when it couples a structure with the
+    /// `particle_particle` contact, else 0: the broker applies that contact's repulsive force once per coupling
+    /// step, explicitly, and the step is bounded by the acoustic step the force is integrated at with WCSPH (see
+    /// [`IsphSolver::stable_dt`]).
+    force_c0: f64,
     scratch: Scratch,
 }
 
@@ -186,6 +191,11 @@ impl IsphSolver {
             wall_normals,
             cfl: spec.cfl,
             apd: spec.apd(),
+            force_c0: if scene.contact.algorithm == ContactAlgorithm::ParticleParticle && !scene.solids.is_empty() {
+                setup::sound_speed(spec, gravity)?
+            } else {
+                0.0
+            },
             scratch: Scratch::default(),
         };
         solver.contact.record_end(&solver.state);

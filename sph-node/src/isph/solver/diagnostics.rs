@@ -39,6 +39,15 @@ impl IsphSolver {
         if self.params.nu > 0.0 {
             dt = dt.min(0.125 * h * h / self.params.nu); // §4.2 viscous condition
         }
+        if self.force_c0 > 0.0 {
+            // The `particle_particle` contact's force, a ∝ (r0/r)^12 (Monaghan 1994, `DESIGN.md` §4.6), is applied
+            // by the broker once per coupling step, explicitly. Its D = 5 g H is made for the WCSPH step, and the
+            // ISPH step (about 3 × longer on the elastic gate) does not resolve it: a particle gets deep into the
+            // force's range and is thrown back at up to 29 m/s, and the structure's nodes take the reaction
+            // (`docs/CORRECTIONS.md`, "ISPH + particle_particle"). The step is bounded by the WCSPH one,
+            // `time_step::stable_dt`'s acoustic condition.
+            dt = dt.min(0.25 * h / (self.force_c0 + v_max));
+        }
         self.cfl
             * if dt.is_finite() {
                 dt
