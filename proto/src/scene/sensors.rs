@@ -90,8 +90,14 @@ mod tests {
     #[test]
     fn a_point_sensor_is_its_point_and_not_in_the_interval_list_unless_asked() {
         let s = lobovsky(&[]);
-        assert_eq!(PressureSensor::of(&s, 2, 0.01).expect("pressure").points, vec![[1.605, 0.003]]);
-        assert!(PressureSensor::of(&s, 4, 0.01).is_none(), "surge_front is not a pressure probe");
+        assert_eq!(
+            PressureSensor::of(&s, 2, 0.01).expect("pressure").points,
+            vec![[1.605, 0.003]]
+        );
+        assert!(
+            PressureSensor::of(&s, 4, 0.01).is_none(),
+            "surge_front is not a pressure probe"
+        );
         let none = lobovsky(&["probe[0].average=none", "probe[1].average=none"]);
         assert!(PressureSensor::interval(&none).is_empty());
         assert_eq!(face_mean([3.25].into_iter()), 3.25);
