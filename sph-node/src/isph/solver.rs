@@ -14,7 +14,6 @@
 
 use cosim_proto::scene::{ContactAlgorithm, FluidSolver as SceneSolver, Scene};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use super::contact::{ContactLayer, ContactRow};
 use super::{bicgstab, ppe, projection, wall_normal, IsphOptions, PpeSource};
@@ -30,6 +29,7 @@ use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup::{self, FluidSetup};
 
 mod diagnostics;
+pub use diagnostics::PpeReport;
 mod fluid_solver;
 mod restore;
 mod source;
@@ -55,25 +55,6 @@ struct Scratch {
     /// The PPE's matrix and right-hand side, assembled anew each step into the allocations of the last.
     ppe: ppe::SparseRows,
     rhs: Vec<f64>,
-}
-
-/// What the last PPE solve did.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PpeReport {
-    /// BiCGSTAB iterations.
-    pub iterations: usize,
-    /// Final relative residual (see [`bicgstab`]).
-    pub residual: f64,
-    /// Fluid particles given p = 0 as free surface.
-    pub free_surface: usize,
-    /// Fluid particles whose support a structure face cuts (the first layer against it and the second row; see
-    /// [`super::contact`]).
-    pub contact: usize,
-    /// Fluid particles given p = 0 because their group of PPE rows reached no Dirichlet row
-    /// ([`ppe::anchor_floating_groups`]).
-    pub anchored: usize,
-    /// Fluid particles found inside a wall at the start of the step and put back on its face.
-    pub wall_pushes: usize,
 }
 
 /// Incompressible SPH solver (projection method).

@@ -2,8 +2,28 @@
 //! PPE solve and the neighbour pairs.
 
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
-use super::{IsphSolver, PpeReport};
+use super::IsphSolver;
+
+/// What the last PPE solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PpeReport {
+    /// BiCGSTAB iterations.
+    pub iterations: usize,
+    /// Final relative residual (see [`crate::isph::bicgstab`]).
+    pub residual: f64,
+    /// Fluid particles given p = 0 as free surface.
+    pub free_surface: usize,
+    /// Fluid particles whose support a structure face cuts (the first layer against it and the second row; see
+    /// [`crate::isph::contact`]).
+    pub contact: usize,
+    /// Fluid particles given p = 0 because their group of PPE rows reached no Dirichlet row
+    /// ([`crate::isph::ppe::anchor_floating_groups`]).
+    pub anchored: usize,
+    /// Fluid particles found inside a wall at the start of the step and put back on its face.
+    pub wall_pushes: usize,
+}
 
 impl IsphSolver {
     /// Neighbour pairs of the current lists (ordered: each pair counts once for each of its particles), the wall
