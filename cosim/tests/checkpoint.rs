@@ -7,6 +7,8 @@
 
 mod common;
 
+use cosim_proto::envelope::PROTOCOL_VERSION;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -82,7 +84,7 @@ fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
     assert_eq!(written.len(), 4, "checkpoints at 0.05, 0.1, 0.15, 0.2 s: {written:?}");
     let manifest = json(&written[0].1.join("checkpoint.json"));
     assert_eq!(manifest["t"].as_f64(), Some(0.05));
-    assert_eq!(manifest["protocol_version"].as_u64(), Some(1));
+    assert_eq!(manifest["protocol_version"].as_u64(), Some(u64::from(PROTOCOL_VERSION)));
     for file in ["scene.toml", "broker.bin", "fem.bin", "sph.bin"] {
         assert!(
             manifest["files"][file]["bytes"].as_u64().unwrap() > 0,
@@ -316,7 +318,10 @@ fn a_checkpoint_from_another_scene_or_version_is_refused() {
     let text = std::fs::read_to_string(&manifest).unwrap();
     std::fs::write(
         &manifest,
-        text.replace("\"protocol_version\": 1", "\"protocol_version\": 7"),
+        text.replace(
+            &format!("\"protocol_version\": {PROTOCOL_VERSION}"),
+            "\"protocol_version\": 7",
+        ),
     )
     .unwrap();
     let other_s = other.display().to_string();
