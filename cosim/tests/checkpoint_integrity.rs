@@ -11,6 +11,8 @@
 
 mod common;
 
+use contact_broker::checkpoint::FORMAT;
+
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -96,7 +98,7 @@ fn a_file_changed_in_place_is_refused_naming_it_and_its_checksums() {
     let dir = scratch("ck-integrity");
     let ck = first_checkpoint(&dir);
     let manifest = json(&ck.join("checkpoint.json"));
-    assert_eq!(manifest["format"].as_u64(), Some(2), "{manifest}");
+    assert_eq!(manifest["format"].as_u64(), Some(u64::from(FORMAT)), "{manifest}");
 
     // Untouched, the checkpoint restarts (the copies below differ from it only by the bytes flipped).
     let intact = copy_of(&ck, &dir.join("intact"));
@@ -153,7 +155,7 @@ fn an_old_format_or_incomplete_manifest_is_refused() {
         &[
             "checkpoint.json",
             "checkpoint format 1",
-            "reads format 2",
+            &format!("reads format {FORMAT}"),
             "no checksums",
         ],
     );
