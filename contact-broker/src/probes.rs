@@ -142,7 +142,6 @@ impl Probes {
                 }
                 ProbeKind::Pressure => {
                     let setup = fluid.ok_or_else(|| format!("probe[{p}].kind: the run has no fluid node"))?;
-                    spec.point.ok_or_else(|| missing("point"))?;
                     let sensor = PressureSensor::of(scene, p, setup.spacing).ok_or_else(|| missing("point"))?;
                     if spec.average == Some(Average::Interval) {
                         interval += 1;
