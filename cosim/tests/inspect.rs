@@ -11,7 +11,8 @@ use std::time::Duration;
 
 use common::*;
 
-const LIMIT: Duration = Duration::from_secs(120);
+/// Bound on each wait (the run itself takes 10–40 s alone; a loaded machine has taken over 120 s for the 0.25 s run).
+const LIMIT: Duration = Duration::from_secs(240);
 
 /// The coarse gate as processes, not waited for.
 fn start(out: &Path, id: &str, end_time: &str) -> Kill {
@@ -114,7 +115,7 @@ fn the_table_follows_a_run_to_its_end() {
     let dir = scratch("inspect-live");
     let out = dir.join("out");
     let id = run_id("inspect-live");
-    let mut run = start(&out, &id, "0.25");
+    let mut run = start(&out, &id, "0.15");
     wait_for_samples(&mut run.0, &out, 2, LIMIT);
     let table = cosim_run(&["inspect", &id, "--interval", "0.2"], LIMIT);
     let text = String::from_utf8_lossy(&table.stdout);

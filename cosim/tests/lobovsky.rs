@@ -125,8 +125,9 @@ fn isph_h30(name: &str) -> [Sensor; 2] {
 /// exactly 0 from 0.1 t* after the first impact on (clipped negative pressures; before the equal sub-steps 11
 /// samples at sensor 1 and 14 at sensor 2 in t* ∈ [3, 7]; the one sample right after the peak, t* = 2.53, still
 /// reads 0 at sensor 2 against 1.75 recorded: docs/CORRECTIONS.md, "ISPH pressure"), and after the impact (t* in
-/// [3, 7]) the RMS difference to the measurement is at most 0.25 ρgH (measured 0.192 and 0.177 with the interval
-/// means, 0.196 and 0.181 with the instantaneous values; before 0.754 and 0.889).
+/// [3, 7]) the RMS difference to the measurement is at most 0.25 ρgH (measured 0.183 and 0.172 with the interval
+/// means, first impact t* 2.385 and 2.390 against 2.444 and 2.460 recorded; 0.192 and 0.177 before the walls'
+/// divergence velocities took the contact weight, 0.754 and 0.889 before the equal sub-steps).
 #[test]
 fn isph_h30_impact_time_level_and_no_dropouts() {
     for s in isph_h30("isph-h30") {
@@ -158,14 +159,15 @@ fn isph_h30_impact_time_level_and_no_dropouts() {
 }
 
 /// The first-impact peak as the sensor probe reports it (`p_sensor1`, `p_sensor2`: the mean over each 1 ms sampling
-/// interval of every ISPH step's value), within a factor 2 of the recorded event (1.5–6 ρgH). NOT YET: measured 12.3
-/// at sensor 1 and 12.5 at sensor 2 (recorded 3.04 and 1.95). The instantaneous probes at the sample times
+/// interval of every ISPH step's value), within a factor 2 of the recorded event (1.5–6 ρgH). NOT YET: measured 5.00
+/// at sensor 1 and 10.34 at sensor 2 (recorded 3.04 and 1.95; 12.3 and 12.5 before the walls' divergence velocities
+/// took the contact weight of their Neumann rows, `sph-node/src/isph/wall_normal.rs`). The instantaneous probes at the sample times
 /// (`p_sensor*_raw`) read 3.92 and 5.85: within an interval the ISPH pressure at the wall still alternates between
 /// its sub-steps at impact, and the sample instants fall on the low ones (docs/CORRECTIONS.md, "ISPH pressure").
 /// Before today's fixes the raw probes read 31.3 and 50.4 (remainder sub-steps), then 12.7 and 26.9 (the walls'
 /// Neumann rows acting on the fluid within 2h of the wall). Issue 16 stays open on this.
 #[test]
-#[ignore = "issue 16: the ISPH impact peak over a sampling interval is 12.3/12.5 ρgH, the bound 6"]
+#[ignore = "issue 16: the ISPH impact peak over a sampling interval is 5.0/10.3 ρgH (sensor 1/2), the bound 6"]
 fn isph_h30_first_impact_peak_within_a_factor_2() {
     for s in isph_h30("isph-h30-peak") {
         let peak = s.peak();

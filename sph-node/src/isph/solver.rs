@@ -81,6 +81,9 @@ pub struct IsphSolver {
     wall_boxes: WallBoxes,
     /// The unit normal of each wall particle ([`super::wall_normal`]).
     wall_normals: Vec<[f64; 2]>,
+    /// Where a fluid particle touches each wall particle's face: its depth behind the face plus Δx/2
+    /// ([`super::wall_normal::contact_weight`]; walls do not move).
+    wall_touch: Vec<f64>,
     /// Factor on the step of §4.3 (`fluid.cfl`, in (0, 1]; 1 unless the scene says otherwise).
     cfl: f64,
     /// APD β (`fluid.apd`, §4.4; 0 disables): the particle shift applied after each step, as for WCSPH.
@@ -144,6 +147,7 @@ impl IsphSolver {
         } = FluidSetup::new(scene, spec, &Tait::new(rho0, 1.0), reach);
         state.rho.iter_mut().for_each(|r| *r = rho0);
         let wall_normals = wall_normal::wall_normals(&walls.x, &wall_boxes);
+        let wall_touch = walls.x.iter().map(|&x| wall_boxes.depth(x) + 0.5 * dx).collect();
         let nw = walls.len();
         let h = params.h;
         let kernel = CubicSpline::new(h);
@@ -170,6 +174,7 @@ impl IsphSolver {
             contact: ContactLayer::default(),
             wall_boxes,
             wall_normals,
+            wall_touch,
             cfl: spec.cfl,
             apd: spec.apd(),
             force_c0: if scene.contact.algorithm == ContactAlgorithm::ParticleParticle && !scene.solids.is_empty() {
@@ -297,13 +302,7 @@ impl IsphSolver {
             &in_contact,
             &source,
             &self.wall_normals,
-            // Where a fluid particle touches each wall's face (`wall_normal::normal_motion_term`); walls do not move.
-            &self
-                .walls
-                .x
-                .iter()
-                .map(|&x| self.wall_boxes.depth(x) + 0.5 * self.params.dx)
-                .collect::<Vec<_>>(),
+            &self.wall_touch,
             dt,
             // The void that cuts a support counts as p = 0 beyond `ppe::VOID_TOLERANCE` of a full support
             // (`ppe::fluid_row`). Computed here, not stored: the checkpoint format stays as it is.

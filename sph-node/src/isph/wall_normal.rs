@@ -9,9 +9,14 @@
 //! to 0.
 //!
 //! The flux through the wall is then imposed once, by the wall rows: in ∇·u* a wall particle carries Δt g plus the
-//! normal part of the fluid's motion next to it, (ũ_w · n) n with ũ_w = Σ_f ũ_f W_wf / Σ_f W_wf (the Shepard
+//! normal part of the fluid's motion next to it, (ũ_w · n) n with ũ_w = Σ_f s_wf ũ_f W_wf / Σ_f W_wf (the Shepard
 //! average, as Adami et al. 2012, Eq. (22), extrapolate the wall velocity), so that the divergence sees only the
-//! motion along the wall, not the normal motion the wall rows stop.
+//! motion along the wall, not the normal motion the wall rows stop. Both take the same contact weight s_wf
+//! ([`contact_weight`]): with the rows weighted and the divergence not (2026-11-25), the normal motion of fluid
+//! near a wall but not touching it was neither stopped by the wall rows nor seen by the fluid rows' divergence;
+//! weighting both (2026-11-27) took the Lobovsky ISPH sensor peaks from 12.3 / 12.5 to 5.0 / 10.3 ρgH, the coupled
+//! ISPH gate's energy gain from +0.103 to +0.062 of its budget, and ISPH at 8 × its step from running on with 2.0 of
+//! its budget to a stop by the energy guard (docs/CORRECTIONS.md, "ISPH pressure").
 //!
 //! Without the normal part (the walls' Neumann rows carrying g only, the normal motion left to the divergence of the
 //! fluid rows), nothing stops a free-surface particle that moves into a wall: in the still-water tank the particles
@@ -41,14 +46,19 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[0] + a[1] * b[1]
 }
 
-/// The velocity the walls carry in ∇·u*: Δt g + (ũ_w · n) n, with ũ_w the Shepard average of u*_f − Δt g over the
-/// fluid neighbours of wall particle w (Δt g alone for a wall particle with no fluid in reach). `view.v` holds u* of
-/// the fluid; the result goes to `out` (one per wall particle, in the order of `normals`).
+/// The velocity the walls carry in ∇·u*: Δt g + (ũ_w · n) n, with ũ_w the Shepard average of s_wf (u*_f − Δt g)
+/// over the fluid neighbours of wall particle w (Δt g alone for a wall particle with no fluid in reach); s_wf is the
+/// contact weight of [`contact_weight`], the same as the wall rows' ([`normal_motion_term`]): the normal motion the
+/// wall rows stop is the motion the divergence does not see, no more and no less. `view.v` holds u* of the fluid;
+/// `touch` is per wall particle as in [`normal_motion_term`]; the result goes to `out` (one per wall particle, in
+/// the order of `normals`).
+#[allow(clippy::too_many_arguments)]
 pub fn divergence_velocities_into(
     view: &ParticleView<'_>,
     list: &NeighborList,
     kernel: &CubicSpline,
     normals: &[[f64; 2]],
+    touch: &[f64],
     dt: f64,
     g: [f64; 2],
     out: &mut Vec<[f64; 2]>,
@@ -61,16 +71,17 @@ pub fn divergence_velocities_into(
         .map(|k| {
             let w = nf + k;
             let n = normals[k];
+            let touch = touch.get(k).copied().unwrap_or(0.0);
             let (mut s, mut sum_w) = (0.0, 0.0);
             for &f in list.of(w) {
                 let f = f as usize;
                 if f >= nf {
                     continue;
                 }
-                let (_, r) = separation(view.x[w], view.x[f]);
+                let (r_wf, r) = separation(view.x[w], view.x[f]);
                 let wgt = kernel.w(r);
                 let u = [view.v[f][0] - dtg[0], view.v[f][1] - dtg[1]];
-                s += dot(u, n) * wgt;
+                s += contact_weight(r_wf, n, touch) * dot(u, n) * wgt;
                 sum_w += wgt;
             }
             // Adami et al. 2012, Eq. (22): ũ_w = Σ_f u_f W_wf / Σ_f W_wf, its normal part only
@@ -78,6 +89,17 @@ pub fn divergence_velocities_into(
             [dtg[0] + un * n[0], dtg[1] + un * n[1]]
         })
         .collect_into_vec(out);
+}
+
+/// The contact weight s_wf = clamp(2 − (−r_wf · n)/touch, 0, 1) of fluid neighbour f of wall particle w (see
+/// [`normal_motion_term`]); 0 where `touch` is not positive (a wall particle outside the boxes).
+#[inline]
+pub fn contact_weight(r_wf: [f64; 2], normal: [f64; 2], touch: f64) -> f64 {
+    if touch > 0.0 {
+        (2.0 + dot(r_wf, normal) / touch).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
 }
 
 /// The term ρ_f s_wf (ũ_f · n)(r_wf · n)/Δt of one fluid neighbour f in the wall row of w (before the division by
@@ -104,7 +126,7 @@ pub fn normal_motion_term(
     g: [f64; 2],
 ) -> f64 {
     let u = [u_star_f[0] - dt * g[0], u_star_f[1] - dt * g[1]];
-    let contact = (2.0 + dot(r_wf, normal) / touch).clamp(0.0, 1.0);
+    let contact = contact_weight(r_wf, normal, touch);
     // ∂p/∂n = ρ u*·n/Δt (Cummins & Rudman 1999), less the ρ g·n of Adami et al. 2012, Eq. (27), on the fluid that
     // touches the wall
     rho_f * contact * dot(u, normal) * dot(r_wf, normal) / dt

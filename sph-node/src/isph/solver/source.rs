@@ -65,6 +65,7 @@ impl IsphSolver {
             &self.scratch.list,
             &self.kernel,
             &self.wall_normals,
+            &self.wall_touch,
             dt,
             g,
             &mut wall_v,
