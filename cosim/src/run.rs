@@ -71,6 +71,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             args.wait_external
         );
     }
+    anyhow::ensure!(
+        !(args.record && args.in_process),
+        "--record keeps the messages the processes exchange: it needs processes mode (drop --in-process)"
+    );
     if let (Some(node), true) = (
         args.external,
         args.checkpoint_interval.is_some() || args.restart.is_some(),
