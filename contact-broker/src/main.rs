@@ -21,7 +21,7 @@ use cosim_bus::status::{serve_status, Board};
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 use cosim_proto::sizing::Part;
-use cosim_proto::trace::{self, Kind};
+use cosim_proto::trace;
 
 /// The co-simulation's step coordinator and contact broker.
 #[derive(Parser, Debug)]
@@ -122,7 +122,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     summary::reserve(&args.out, &args.run, &args.mode)?;
     // The body keeps a handle of the session (a shared one: cloning it opens nothing).
     let recorder = match args.record {
-        true => Some(Recorder::create(&args.out)?),
+        true => Some(Recorder::begin(&args.out, &args.run, &setup)?),
         false => None,
     };
     let result = serve(&args, &setup, session.clone(), endpoints, &interrupt, recorder.as_ref());
@@ -164,9 +164,6 @@ fn serve(
         None => None,
     };
     let _scene_queryable = transport::serve_scene(&session, &args.run, scene.scene.to_toml())?;
-    if let Some(r) = recorder {
-        r.record(Kind::Scene, trace::Node::Broker, 0, scene.scene.to_toml().as_bytes());
-    }
     // Each node asks, once it has the scene, whether it continues from a saved state.
     let saved = |data: Option<&Vec<u8>>| {
         let r = setup.restart.as_ref()?;
@@ -176,27 +173,6 @@ fn serve(
         transport::serve_restore(&session, &args.run, cosim_proto::keys::FEM, saved(setup.saved_fem()))?,
         transport::serve_restore(&session, &args.run, cosim_proto::keys::SPH, saved(setup.saved_sph()))?,
     );
-    if let Some(r) = recorder {
-        // The replies the nodes of this scene will get, as they get them.
-        let nodes = [
-            (
-                fem_subs.is_some(),
-                cosim_proto::keys::FEM,
-                trace::Node::Fem,
-                saved(setup.saved_fem()),
-            ),
-            (
-                sph_subs.is_some(),
-                cosim_proto::keys::SPH,
-                trace::Node::Sph,
-                saved(setup.saved_sph()),
-            ),
-        ];
-        for (_, topics, node, saved) in nodes.into_iter().filter(|n| n.0) {
-            let reply = transport::restore_reply(&args.run, topics, saved)?;
-            r.record(Kind::Restore, node, 0, &reply);
-        }
-    }
     let _alive = session
         .liveliness()
         .declare_token(key(&args.run, topic::BROKER_ALIVE))

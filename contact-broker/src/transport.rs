@@ -19,7 +19,7 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
-use cosim_proto::trace::{Kind, RawEnvelope};
+use cosim_proto::trace::Kind;
 
 pub use cosim_bus::session::{
     open_client, open_client_from, open_listening, open_listening_from, open_session, open_session_from,
@@ -245,13 +245,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         Ok(())
     }
 
-    /// [`node_error`], recorded when it is this run's error report.
+    /// [`node_error`], recorded when it is this run's error report: under the step of the last command sent (a node
+    /// reports its failure with step 0 in its envelope; it fails while it works on that command).
     fn node_error(&self, sample: &Sample) -> Option<LinkError> {
         let e = node_error(sample, &self.run, &self.topics)?;
         if let Some(tap) = &self.tap {
-            let bytes = sample.payload().to_bytes();
-            let step = RawEnvelope::split(&bytes).map_or(0, |env| env.step);
-            tap.record(Kind::Error, step, &bytes);
+            let step = self.last_command.as_ref().map_or(0, |(s, _)| *s);
+            tap.record(Kind::Error, step, &sample.payload().to_bytes());
         }
         Some(e)
     }

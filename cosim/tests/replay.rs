@@ -35,7 +35,10 @@ fn record(name: &str, extra: &[&str]) -> PathBuf {
 /// `cosim replay ARGS`, bounded.
 fn replay(args: &[&str]) -> Output {
     let mut cmd = Command::new(cosim());
-    cmd.current_dir(root()).arg("replay").args(args).env("COSIM_BIN_DIR", bin_dir());
+    cmd.current_dir(root())
+        .arg("replay")
+        .args(args)
+        .env("COSIM_BIN_DIR", bin_dir());
     run_bounded(&mut cmd, Duration::from_secs(60))
 }
 
@@ -71,10 +74,18 @@ fn recorded_gate_replays_byte_for_byte_against_both_nodes() {
     let trace = trace_of(&out);
     assert_eq!(matched(&replay(&[&trace, "--node", "fem"])), steps + 1);
     assert_eq!(matched(&replay(&[&trace, "--node", "sph"])), steps + 1);
+    // A run in one process records the messages its nodes would have exchanged: they replay the same.
+    let inside = record("replay_gate_in_process", &["--record", "--in-process"]);
+    let trace = trace_of(&inside);
+    assert_eq!(matched(&replay(&[&trace, "--node", "fem"])), steps + 1);
+    assert_eq!(matched(&replay(&[&trace, "--node", "sph"])), steps + 1);
     // Recording changes nothing the run writes.
     let plain = record("replay_gate_plain", &[]);
     for file in ["probes.csv", "frames/structure_00002.vtu", "frames/particles_00002.vtu"] {
-        let (a, b) = (std::fs::read(out.join(file)).unwrap(), std::fs::read(plain.join(file)).unwrap());
+        let (a, b) = (
+            std::fs::read(out.join(file)).unwrap(),
+            std::fs::read(plain.join(file)).unwrap(),
+        );
         assert!(a == b, "{file} differs with --record");
     }
     // The end record says how the run ended and what the recording cost.
@@ -83,8 +94,14 @@ fn recorded_gate_replays_byte_for_byte_against_both_nodes() {
     let end = t.records.last().unwrap();
     assert_eq!(end.kind, cosim_proto::trace::Kind::End);
     let end: serde_json::Value = serde_json::from_slice(&end.payload).unwrap();
-    assert_eq!((end["status"].as_str(), end["steps"].as_u64()), (Some("ok"), Some(steps)));
-    assert_eq!(end["bytes"].as_u64().unwrap() as usize + 8 + 10 + t.records.last().unwrap().payload.len(), bytes.len());
+    assert_eq!(
+        (end["status"].as_str(), end["steps"].as_u64()),
+        (Some("ok"), Some(steps))
+    );
+    assert_eq!(
+        end["bytes"].as_u64().unwrap() as usize + 8 + 10 + t.records.last().unwrap().payload.len(),
+        bytes.len()
+    );
 }
 
 #[test]
@@ -127,7 +144,10 @@ fn a_trace_cut_mid_record_replays_its_complete_steps() {
     assert_eq!(matched(&got), complete);
     assert!(complete > 50 && complete < 315, "{complete}");
     let said = String::from_utf8_lossy(&got.stderr);
-    assert!(said.contains("stops before its end") && said.contains("cut short"), "{said}");
+    assert!(
+        said.contains("stops before its end") && said.contains("cut short"),
+        "{said}"
+    );
     // Bad input: not a trace, and a node the run did not have (exit 2, one line).
     let scene = root().join("scenes/elastic_gate.toml").display().to_string();
     let not = replay(&[&scene, "--node", "fem"]);
@@ -145,7 +165,13 @@ fn killing_the_broker_mid_run_leaves_a_trace_that_replays() {
             .current_dir(root())
             .args(["run", "--quiet", "--record", "--run-id", &id, "--out"])
             .arg(&out)
-            .args(["scenes/elastic_gate.toml", "--set", "run.end_time=0.5", "--set", "fluid.spacing=0.004"])
+            .args([
+                "scenes/elastic_gate.toml",
+                "--set",
+                "run.end_time=0.5",
+                "--set",
+                "fluid.spacing=0.004",
+            ])
             .env("COSIM_BIN_DIR", bin_dir())
             .stdin(Stdio::null())
             .stdout(Stdio::null())
@@ -156,7 +182,10 @@ fn killing_the_broker_mid_run_leaves_a_trace_that_replays() {
     let file = out.join("trace/trace.bin");
     let started = Instant::now();
     while std::fs::metadata(&file).map_or(0, |m| m.len()) < 2_000_000 {
-        assert!(run.0.try_wait().unwrap().is_none(), "the run ended before it was killed");
+        assert!(
+            run.0.try_wait().unwrap().is_none(),
+            "the run ended before it was killed"
+        );
         assert!(started.elapsed() < Duration::from_secs(60), "the run did not get going");
         std::thread::sleep(Duration::from_millis(5));
     }
@@ -164,12 +193,18 @@ fn killing_the_broker_mid_run_leaves_a_trace_that_replays() {
         .into_iter()
         .find(|(_, name)| name == "contact-broker")
         .expect("the broker is a child of cosim run");
-    Command::new("kill").args(["-KILL", &broker.0.to_string()]).status().unwrap();
+    Command::new("kill")
+        .args(["-KILL", &broker.0.to_string()])
+        .status()
+        .unwrap();
     let status = wait_exit(&mut run.0, Instant::now() + Duration::from_secs(30), "cosim run");
     assert!(!status.success());
     let bytes = std::fs::read(&file).unwrap();
     let t = cosim_proto::trace::parse(&bytes).unwrap();
-    assert!(t.records.iter().all(|r| r.kind != cosim_proto::trace::Kind::End), "no end record after a SIGKILL");
+    assert!(
+        t.records.iter().all(|r| r.kind != cosim_proto::trace::Kind::End),
+        "no end record after a SIGKILL"
+    );
     let states = |node| {
         t.records
             .iter()
@@ -180,5 +215,8 @@ fn killing_the_broker_mid_run_leaves_a_trace_that_replays() {
     let fem = matched(&replay(&[&trace, "--node", "fem"]));
     assert_eq!(fem, states(cosim_proto::trace::Node::Fem));
     assert!(fem > 100, "{fem}");
-    assert_eq!(matched(&replay(&[&trace, "--node", "sph"])), states(cosim_proto::trace::Node::Sph));
+    assert_eq!(
+        matched(&replay(&[&trace, "--node", "sph"])),
+        states(cosim_proto::trace::Node::Sph)
+    );
 }

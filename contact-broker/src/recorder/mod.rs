@@ -15,6 +15,12 @@ use std::time::Instant;
 use anyhow::Context;
 use cosim_proto::trace::{self, Kind, Node};
 
+use crate::setup::RunSetup;
+
+mod recorded;
+
+pub use recorded::Recorded;
+
 /// The trace's file name inside `DIR/trace/`.
 pub const FILE: &str = "trace.bin";
 
@@ -83,6 +89,37 @@ impl Recorder {
             }
         }
         inner.cost.seconds += started.elapsed().as_secs_f64();
+    }
+
+    /// [`Recorder::create`], then the records a run starts with: the scene as the broker serves it, and the
+    /// broker's restore reply to each node the scene has (`docs/PROTOCOL.md` §10).
+    pub fn begin(out: &Path, run: &str, setup: &RunSetup) -> anyhow::Result<Self> {
+        let r = Self::create(out)?;
+        let scene = &setup.scene.scene;
+        r.record(Kind::Scene, Node::Broker, 0, scene.to_toml().as_bytes());
+        let saved = |data: Option<&Vec<u8>>| {
+            let at = setup.restart.as_ref()?;
+            Some((at.broker.step, at.broker.t, data?.clone()))
+        };
+        let nodes = [
+            (
+                !scene.solids.is_empty(),
+                cosim_proto::keys::FEM,
+                Node::Fem,
+                saved(setup.saved_fem()),
+            ),
+            (
+                scene.fluid.is_some(),
+                cosim_proto::keys::SPH,
+                Node::Sph,
+                saved(setup.saved_sph()),
+            ),
+        ];
+        for (_, topics, node, saved) in nodes.into_iter().filter(|n| n.0) {
+            let reply = crate::transport::restore_reply(run, topics, saved)?;
+            r.record(Kind::Restore, node, 0, &reply);
+        }
+        Ok(r)
     }
 
     /// What the recording cost so far.
