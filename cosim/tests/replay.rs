@@ -220,3 +220,39 @@ fn killing_the_broker_mid_run_leaves_a_trace_that_replays() {
         states(cosim_proto::trace::Node::Sph)
     );
 }
+
+/// A run continued from a checkpoint records the state the broker hands each node (the restore reply): its trace
+/// replays from there, the node restored from the recorded state.
+#[test]
+fn a_restarted_run_replays_from_its_checkpoint() {
+    let first = record("replay_ckpt", &["--checkpoint-interval", "0.01"]);
+    let at = first.join("checkpoints/156");
+    assert!(at.is_dir(), "no checkpoint at step 156");
+    let at = at.display().to_string();
+    let out = record("replay_restarted", &["--restart", &at, "--record"]);
+    let trace = trace_of(&out);
+    // Steps 157 to 314 (158 commands answered).
+    assert_eq!(matched(&replay(&[&trace, "--node", "fem"])), 158);
+    assert_eq!(matched(&replay(&[&trace, "--node", "sph"])), 158);
+    // The recorded run had no structure node: nothing to replay (exit 2, one line).
+    let fluid = scratch("replay_fluid_only");
+    let fluid_s = fluid.display().to_string();
+    let id = run_id("replay_fluid_only");
+    run_ok(&[
+        "run",
+        "scenes/dam_break.toml",
+        "--quiet",
+        "--record",
+        "--run-id",
+        &id,
+        "--out",
+        &fluid_s,
+        "--set",
+        "run.end_time=0.01",
+        "--set",
+        "fluid.spacing=0.01",
+    ]);
+    let none = replay(&[&trace_of(&fluid), "--node", "fem"]);
+    assert_eq!(none.status.code(), Some(2), "{}", text(&none));
+    assert!(text(&none).contains("fem-node never registered"), "{}", text(&none));
+}
