@@ -172,6 +172,12 @@ pub struct Trace {
 /// Read a trace: the header, then records up to the end of the file or up to the first one that is incomplete,
 /// fails its checksum or has an unknown kind or node (recorded in [`Trace::torn`]; what came before is kept).
 pub fn parse(bytes: &[u8]) -> Result<Trace, TraceError> {
+    parse_with(bytes, |_, _| true)
+}
+
+/// [`parse`], keeping only the records `keep` accepts (by kind and node): the others are checked but not copied,
+/// so a reader of one node's part of a large trace holds little more than that part.
+pub fn parse_with(bytes: &[u8], mut keep: impl FnMut(Kind, Node) -> bool) -> Result<Trace, TraceError> {
     let head = bytes.get(..HEADER_BYTES).ok_or(TraceError::NotATrace)?;
     if head[..8] != MAGIC {
         return Err(TraceError::NotATrace);
@@ -211,13 +217,16 @@ pub fn parse(bytes: &[u8]) -> Result<Trace, TraceError> {
         };
         let mut step = [0u8; 8];
         step.copy_from_slice(&body[2..RECORD_FIXED_BYTES]);
+        at = start + len;
+        if !keep(kind, node) {
+            continue;
+        }
         records.push(Record {
             kind,
             node,
             step: u64::from_le_bytes(step),
             payload: body[RECORD_FIXED_BYTES..].to_vec(),
         });
-        at = start + len;
     };
     Ok(Trace {
         protocol_version,

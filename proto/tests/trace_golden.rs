@@ -107,6 +107,9 @@ fn golden_trace_reads_back() {
     let back = Envelope::<StepCommand>::decode(&moved, "replay-7", "command").unwrap();
     assert_eq!(back.encode()[..], moved[..]);
     assert_eq!(RawEnvelope::split(&moved).unwrap().body, raw.body);
+    // One node's part: the other records are read past, not kept.
+    let fem = trace::parse_with(&hex(GOLDEN), |_, node| node == Node::Fem).unwrap();
+    assert_eq!((fem.records.len(), fem.records[0].step, fem.torn), (1, 3, None));
 }
 
 /// A file cut at any byte (a process killed mid-write) reads up to its last complete record and says where it stops.

@@ -64,7 +64,14 @@ pub fn trace_file(path: &Path) -> PathBuf {
 pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
     let path = trace_file(path);
     let bytes = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-    let trace = trace::parse(&bytes).with_context(|| path.display().to_string())?;
+    let who = match node {
+        ExternalNode::Fem => Node::Fem,
+        ExternalNode::Sph => Node::Sph,
+    };
+    // Only the broker's records and this node's are kept: a replay holds little more than its part of the trace.
+    let trace =
+        trace::parse_with(&bytes, |_, n| n == who || n == Node::Broker).with_context(|| path.display().to_string())?;
+    drop(bytes);
     anyhow::ensure!(
         trace.protocol_version == cosim_proto::PROTOCOL_VERSION,
         "{}: recorded with protocol version {}, this build speaks {}",
@@ -72,10 +79,6 @@ pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
         trace.protocol_version,
         cosim_proto::PROTOCOL_VERSION
     );
-    let who = match node {
-        ExternalNode::Fem => Node::Fem,
-        ExternalNode::Sph => Node::Sph,
-    };
     let mut scene = None;
     let mut restore = None;
     let mut setup = None;
