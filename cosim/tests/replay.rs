@@ -256,3 +256,45 @@ fn a_restarted_run_replays_from_its_checkpoint() {
     assert_eq!(none.status.code(), Some(2), "{}", text(&none));
     assert!(text(&none).contains("fem-node never registered"), "{}", text(&none));
 }
+
+/// A run that blew up: the node's failure report is recorded under the step it failed at, and the replayed node
+/// fails at that step with the same report (compared like an answer).
+#[test]
+fn an_unstable_runs_trace_replays_its_failure() {
+    let out = scratch("replay_unstable");
+    let out_s = out.display().to_string();
+    let id = run_id("replay_unstable");
+    let mut cmd = Command::new(cosim());
+    cmd.current_dir(root())
+        .args([
+            "run",
+            "cosim/tests/data/fluid_unstable.toml",
+            "--quiet",
+            "--record",
+            "--run-id",
+            &id,
+            "--out",
+            &out_s,
+        ])
+        .env("COSIM_BIN_DIR", bin_dir());
+    let run = run_bounded(&mut cmd, RUN_LIMIT);
+    assert_eq!(run.status.code(), Some(1), "{}", text(&run));
+    let bytes = std::fs::read(out.join("trace/trace.bin")).unwrap();
+    let t = cosim_proto::trace::parse(&bytes).unwrap();
+    let error = t
+        .records
+        .iter()
+        .find(|r| r.kind == cosim_proto::trace::Kind::Error)
+        .expect("an error record");
+    let states = t
+        .records
+        .iter()
+        .filter(|r| r.kind == cosim_proto::trace::Kind::State)
+        .count() as u64;
+    assert_eq!(
+        error.step, states,
+        "the failure is recorded under the step after the last answer"
+    );
+    // Every answer and the failure itself.
+    assert_eq!(matched(&replay(&[&trace_of(&out), "--node", "sph"])), states + 1);
+}
