@@ -11,6 +11,7 @@ pub mod interface;
 pub mod link;
 pub mod output;
 pub mod probes;
+pub mod recorder;
 pub mod setup;
 pub mod summary;
 pub mod transport;

@@ -12,6 +12,7 @@ use anyhow::Context;
 use clap::Parser;
 use contact_broker::coordinator::{Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
+use contact_broker::recorder::{Recorder, Tap};
 use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, SummaryBuilder};
 use contact_broker::transport::{self, ZenohLink};
@@ -20,6 +21,7 @@ use cosim_bus::status::{serve_status, Board};
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 use cosim_proto::sizing::Part;
+use cosim_proto::trace;
 
 /// The co-simulation's step coordinator and contact broker.
 #[derive(Parser, Debug)]
@@ -60,6 +62,9 @@ struct Args {
     /// own settings (mode, endpoints, multicast scouting off, timeouts) are put on top of it.
     #[arg(long, value_name = "FILE")]
     zenoh_config: Option<PathBuf>,
+    /// Keep every message of the run in `DIR/trace/trace.bin` (`docs/PROTOCOL.md` §10), for `cosim replay`.
+    #[arg(long)]
+    record: bool,
     /// Mode written into summary.json.
     #[arg(long, default_value = "processes")]
     mode: String,
@@ -116,7 +121,11 @@ fn run(args: Args) -> anyhow::Result<()> {
     // still gets the summary that says so (`contact_broker::summary`).
     summary::reserve(&args.out, &args.run, &args.mode)?;
     // The body keeps a handle of the session (a shared one: cloning it opens nothing).
-    let result = serve(&args, &setup, session.clone(), endpoints, &interrupt);
+    let recorder = match args.record {
+        true => Some(Recorder::begin(&args.out, &args.run, &setup)?),
+        false => None,
+    };
+    let result = serve(&args, &setup, session.clone(), endpoints, &interrupt, recorder.as_ref());
     // A run that failed before the coordinator wrote its summary (a node that never registered): say why there.
     if let Err(e) = &result {
         let written = std::fs::read_to_string(args.out.join(summary::FILE))
@@ -142,6 +151,7 @@ fn serve(
     session: zenoh::Session,
     endpoints: Vec<String>,
     interrupt: &Interrupt,
+    recorder: Option<&Recorder>,
 ) -> anyhow::Result<()> {
     let scene = &setup.scene;
     // Subscriptions first, then the scene queryable: a node that got the scene can already be heard.
@@ -187,6 +197,18 @@ fn serve(
         Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
         None => None,
     };
+    if let Some(r) = recorder {
+        let tap = |node| Tap {
+            recorder: r.clone(),
+            node,
+        };
+        if let Some(link) = fem.as_mut() {
+            link.record_to(tap(trace::Node::Fem));
+        }
+        if let Some(link) = sph.as_mut() {
+            link.record_to(tap(trace::Node::Sph));
+        }
+    }
     board.update(|s| {
         if let Some(f) = &fem {
             s.counts.insert("fem_nodes".into(), f.setup().nodes.len() as u64);
@@ -242,6 +264,17 @@ fn serve(
         ControlFlow::Continue(())
     };
     let outcome = setup.run(nodes, &info, &mut report);
+    if let Some(r) = recorder {
+        let s = &outcome.summary;
+        r.finish(s.status.as_str(), &s.message, s.steps);
+        let cost = r.cost();
+        tracing::info!(
+            "trace: {} records, {} bytes, {:.3} s spent recording",
+            cost.records,
+            cost.bytes,
+            cost.seconds
+        );
+    }
     board.update(|s| {
         s.health = if outcome.summary.status.is_ok() {
             "finished"

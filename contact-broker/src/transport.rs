@@ -18,6 +18,8 @@ use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
+use crate::recorder::Tap;
+use cosim_proto::trace::Kind;
 
 pub use cosim_bus::session::{
     open_client, open_client_from, open_listening, open_listening_from, open_session, open_session_from,
@@ -45,12 +47,7 @@ pub fn serve_restore(
     topics: NodeTopics,
     saved: Option<(u64, f64, Vec<u8>)>,
 ) -> anyhow::Result<Queryable<()>> {
-    let (step, t, data) = saved.unwrap_or((0, 0.0, Vec::new()));
-    let body = NodeCheckpoint {
-        node: topics.name.into(),
-        data,
-    };
-    let bytes = Envelope::new(run, step, t, body).encode_checked(topics.restore)?;
+    let bytes = restore_reply(run, topics, saved)?;
     session
         .declare_queryable(key(run, topics.restore))
         .callback(move |query| {
@@ -60,6 +57,16 @@ pub fn serve_restore(
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// The reply [`serve_restore`] gives, encoded (`saved` as there).
+pub fn restore_reply(run: &str, topics: NodeTopics, saved: Option<(u64, f64, Vec<u8>)>) -> anyhow::Result<Vec<u8>> {
+    let (step, t, data) = saved.unwrap_or((0, 0.0, Vec::new()));
+    let body = NodeCheckpoint {
+        node: topics.name.into(),
+        data,
+    };
+    Ok(Envelope::new(run, step, t, body).encode_checked(topics.restore)?)
 }
 
 type Sub = Subscriber<FifoChannelHandler<Sample>>;
@@ -108,6 +115,10 @@ pub struct ZenohLink<S, T> {
     step_timeout: Duration,
     /// The last command sent (its step and bytes), to send again when its answer does not come.
     last_command: Option<(u64, ZBytes)>,
+    /// The registration as received (its step and bytes), for the trace.
+    registration: (u64, Vec<u8>),
+    /// Where every message sent and accepted is recorded (`--record`).
+    tap: Option<Tap>,
     _state: std::marker::PhantomData<T>,
 }
 
@@ -147,15 +158,16 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         let deadline = Instant::now() + wait;
         // The last registration refused, kept over the whole wait: when no good one comes, it is the reason.
         let mut refused: Option<String> = None;
-        let setup = loop {
+        let (setup, registration) = loop {
             let got = subs
                 .setup
                 .recv_timeout(Duration::from_millis(50))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
             // A registration that does not decode as this run's is refused: logged, and the wait goes on.
             if let Some(sample) = got {
-                match Envelope::<S>::decode(&sample.payload().to_bytes(), run, topics.setup) {
-                    Ok(env) => break env.body,
+                let bytes = sample.payload().to_bytes();
+                match Envelope::<S>::decode(&bytes, run, topics.setup) {
+                    Ok(env) => break (env.body, (env.step, bytes.into_owned())),
                     Err(e) => {
                         tracing::error!("{}: refused a registration: {e}", topics.name);
                         refused = Some(e.to_string());
@@ -193,8 +205,16 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             alive: subs.alive,
             step_timeout,
             last_command: None,
+            registration,
+            tap: None,
             _state: std::marker::PhantomData,
         })
+    }
+
+    /// Record every message of this node from now on into `tap` (`--record`), starting with its registration.
+    pub fn record_to(&mut self, tap: Tap) {
+        tap.record(Kind::Setup, self.registration.0, &self.registration.1);
+        self.tap = Some(tap);
     }
 
     fn failed(&self, message: impl Into<String>) -> LinkError {
@@ -207,7 +227,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     /// A failure the node reported or its death, if either happened.
     fn check_node(&self) -> Result<(), LinkError> {
         while let Ok(Some(sample)) = self.error.try_recv() {
-            if let Some(e) = node_error(&sample, &self.run, &self.topics) {
+            if let Some(e) = self.node_error(&sample) {
                 return Err(e);
             }
         }
@@ -215,7 +235,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             if sample.kind() == SampleKind::Delete {
                 // It may have reported why just before it went.
                 if let Ok(Some(sample)) = self.error.recv_timeout(Duration::from_millis(200)) {
-                    if let Some(e) = node_error(&sample, &self.run, &self.topics) {
+                    if let Some(e) = self.node_error(&sample) {
                         return Err(e);
                     }
                 }
@@ -223,6 +243,17 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             }
         }
         Ok(())
+    }
+
+    /// [`node_error`], recorded when it is this run's error report: under the step of the last command sent (a node
+    /// reports its failure with step 0 in its envelope; it fails while it works on that command).
+    fn node_error(&self, sample: &Sample) -> Option<LinkError> {
+        let e = node_error(sample, &self.run, &self.topics)?;
+        if let Some(tap) = &self.tap {
+            let step = self.last_command.as_ref().map_or(0, |(s, _)| *s);
+            tap.record(Kind::Error, step, &sample.payload().to_bytes());
+        }
+        Some(e)
     }
 }
 
@@ -244,6 +275,9 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         let bytes = Envelope::new(&self.run, step, t, cmd)
             .encode_checked(self.topics.command)
             .map_err(|e| self.failed(e.to_string()))?;
+        if let Some(tap) = &self.tap {
+            tap.record(Kind::Command, step, &bytes);
+        }
         let bytes = ZBytes::from(bytes);
         self.command
             .put(bytes.clone())
@@ -316,10 +350,16 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
-                    match Envelope::<T>::decode(&sample.payload().to_bytes(), &self.run, self.topics.state)
+                    let bytes = sample.payload().to_bytes();
+                    match Envelope::<T>::decode(&bytes, &self.run, self.topics.state)
                         .and_then(|e| e.expect_step(step, self.topics.state))
                     {
-                        Ok(env) => return Ok(env.body),
+                        Ok(env) => {
+                            if let Some(tap) = &self.tap {
+                                tap.record(Kind::State, step, &bytes);
+                            }
+                            return Ok(env.body);
+                        }
                         // An answer to an earlier step, sent again after the broker sent its command again.
                         Err(CodecError::Step { got, .. }) if got < step => {
                             tracing::debug!("{}: a repeated answer to step {got}, dropped", self.topics.name);

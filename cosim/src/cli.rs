@@ -30,6 +30,9 @@ pub enum Command {
     /// Serve as a zenoh router (the one `zenohd` runs) until killed: the hub of a run spread over hosts, which every
     /// process joins with `--connect ENDPOINT --client`.
     Router(RouterArgs),
+    /// Run one node alone on the commands of a recorded run (`cosim run --record`) and compare its answers with
+    /// the recorded ones: the first divergence is named (exit 1), else "matched N steps".
+    Replay(ReplayArgs),
     /// One case of `cosim bench`: `cosim run` that also writes its peak resident memory and CPU time to a file.
     #[command(hide = true)]
     BenchRun(BenchRunArgs),
@@ -81,6 +84,10 @@ pub struct RunArgs {
     /// the one it was written with (only `run.end_time` may differ).
     #[arg(long, value_name = "CHECKPOINT")]
     pub restart: Option<PathBuf>,
+    /// Keep every message of the run (setup, commands, states, with their envelopes) in `DIR/trace/`, for
+    /// `cosim replay` (format: `docs/PROTOCOL.md` §10).
+    #[arg(long)]
+    pub record: bool,
 }
 
 /// A node an outside program can take the place of.
@@ -217,4 +224,31 @@ pub struct RouterArgs {
     /// listen endpoints and multicast scouting off are put on top of it.
     #[arg(long, value_name = "FILE")]
     pub zenoh_config: Option<PathBuf>,
+}
+
+/// `cosim replay`.
+#[derive(Args, Debug, Clone)]
+pub struct ReplayArgs {
+    /// The trace: `DIR/trace` of a run made with `--record` (or the `trace.bin` file in it).
+    pub trace: PathBuf,
+    /// The node to run again.
+    #[arg(long, value_enum)]
+    pub node: ExternalNode,
+    /// Run this program in the node's place instead of the built-in one: a command line, split as the shell does
+    /// (run by `sh`), to which `--run ID --connect ENDPOINT` are appended.
+    #[arg(long, value_name = "COMMAND")]
+    pub exec: Option<String>,
+    /// Compare numbers within this relative tolerance instead of byte for byte: |replayed − recorded| ≤ atol +
+    /// rtol·|recorded|.
+    #[arg(long, value_name = "R")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (with or without `--rtol`).
+    #[arg(long, value_name = "A")]
+    pub atol: Option<f64>,
+    /// Seconds to wait for the node to register, and for each of its answers.
+    #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+    pub timeout: f64,
+    /// File for the node's log (stderr); default: a file in the temporary folder, named when the replay fails.
+    #[arg(long, value_name = "FILE")]
+    pub log: Option<PathBuf>,
 }

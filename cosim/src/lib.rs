@@ -1,6 +1,7 @@
 //! The `cosim` command: launches a scene as processes or in one process (`run`), validates it (`check`),
 //! overlays a probe of several runs (`compare`), measures run time against error over a suite of scenes (`bench`),
-//! shows a running run's status (`inspect`), serves as the zenoh router of a run over several hosts (`router`).
+//! shows a running run's status (`inspect`), serves as the zenoh router of a run over several hosts (`router`),
+//! runs one node again on a recorded run's messages (`replay`).
 #![warn(missing_docs)]
 
 pub mod bench;
@@ -12,5 +13,6 @@ pub mod inspect;
 pub mod launch;
 pub mod progress;
 pub mod registry;
+pub mod replay;
 pub mod router;
 pub mod run;

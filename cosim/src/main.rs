@@ -27,6 +27,7 @@ fn main() -> ExitCode {
         Command::BenchRun(args) => cosim::bench::bench_run(&args),
         Command::Inspect(args) => cosim::inspect::inspect(&args),
         Command::Router(args) => cosim::router::router(&args),
+        Command::Replay(args) => cosim::replay::replay(&args),
     };
     match result {
         Ok(code) => code,

@@ -5,13 +5,15 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use contact_broker::coordinator::{Nodes, RunInfo};
-use contact_broker::link::{FemLink, SphLink};
+use contact_broker::link::NodeLink;
+use contact_broker::recorder::{Recorded, Recorder, Tap};
 use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::LoadedScene;
 use cosim_proto::sizing::Part;
+use cosim_proto::trace::Node;
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -194,6 +196,11 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         rayon_threads(n)?;
     }
     let scene = &setup.scene;
+    // `--record`: the messages the nodes would exchange as processes (`docs/PROTOCOL.md` §10).
+    let recorder = match args.record {
+        true => Some(Recorder::begin(&info.out, &info.run_id, setup)?),
+        false => None,
+    };
     let mut fem = match scene.scene.solids.is_empty() {
         false => {
             let mut core = FemCore::new(&scene.scene).context("fem-node")?;
@@ -201,7 +208,7 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
                 core.restore(data)
                     .context("fem-node: cannot restart from the checkpoint")?;
             }
-            Some(in_process::link("fem-node", core))
+            Some(recorded(in_process::link("fem-node", core), &recorder, Node::Fem, info))
         }
         true => None,
     };
@@ -212,13 +219,13 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
                 core.restore(data)
                     .context("sph-node: cannot restart from the checkpoint")?;
             }
-            Some(in_process::link("sph-node", core))
+            Some(recorded(in_process::link("sph-node", core), &recorder, Node::Sph, info))
         }
         None => None,
     };
     let nodes = Nodes {
-        fem: fem.as_mut().map(|l| l as &mut FemLink),
-        sph: sph.as_mut().map(|l| l as &mut SphLink),
+        fem: fem.as_deref_mut(),
+        sph: sph.as_deref_mut(),
     };
     // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once).
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
@@ -226,7 +233,35 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         bar.update(p);
         interrupt.control()
     });
+    if let Some(r) = &recorder {
+        let s = &outcome.summary;
+        r.finish(s.status.as_str(), &s.message, s.steps);
+    }
     Ok(outcome.summary)
+}
+
+/// `link`, its messages recorded when `recorder` is set.
+fn recorded<L>(
+    link: L,
+    recorder: &Option<Recorder>,
+    node: Node,
+    info: &RunInfo,
+) -> Box<dyn NodeLink<Setup = L::Setup, State = L::State>>
+where
+    L: NodeLink + 'static,
+    L::Setup: serde::Serialize,
+    L::State: serde::Serialize,
+{
+    match recorder {
+        Some(r) => {
+            let tap = Tap {
+                recorder: r.clone(),
+                node,
+            };
+            Box::new(Recorded::new(link, tap, &info.run_id))
+        }
+        None => Box::new(link),
+    }
 }
 
 fn rayon_threads(n: usize) -> anyhow::Result<()> {

@@ -21,8 +21,12 @@ use std::time::{Duration, Instant};
 use common::*;
 use contact_broker::coordinator::{self, Nodes, RunInfo};
 use contact_broker::link::{FemLink, InProcess, LinkError, SphLink};
+use contact_broker::recorder::{Recorded, Recorder, Tap};
+use contact_broker::setup::RunSetup;
 use cosim_proto::messages::{Energies, FemMesh, FemSnapshot, FemState, Segment, StepCommand};
 use cosim_proto::scene::{self, Scene};
+use cosim_proto::sizing::Part;
+use cosim_proto::trace::Node;
 use sph_node::core::SphCore;
 
 const SCENE: &str = "cosim/tests/data/plate_on_springs.toml";
@@ -197,26 +201,45 @@ impl RigidPlate {
     }
 }
 
-/// The scene with the Rust twin in place of the Python node, in this process.
-fn run_rust_twin(out: &Path) -> f64 {
+/// The scene with the Rust twin in place of the Python node, in this process; with `record`, its messages are kept in
+/// `out/trace/` as `cosim run --record` keeps them.
+fn run_rust_twin(out: &Path, record: bool) -> f64 {
     let loaded = scene::load(&root().join(SCENE), &[]).unwrap();
     let mut plate = RigidPlate::new(&loaded.scene, STIFFNESS, DAMPING_RATIO);
-    let mut fem = InProcess::new(plate.mesh(&loaded.scene.solids[0].name), move |cmd: &StepCommand| {
+    let fem = InProcess::new(plate.mesh(&loaded.scene.solids[0].name), move |cmd: &StepCommand| {
         Ok::<_, LinkError>(plate.handle(cmd))
     });
-    let mut sph = cosim::in_process::link("sph-node", SphCore::new(&loaded.scene).unwrap());
+    let sph = cosim::in_process::link("sph-node", SphCore::new(&loaded.scene).unwrap());
     std::fs::create_dir_all(out).unwrap();
     let info = RunInfo {
         run_id: run_id("rust_twin"),
         mode: "in-process".into(),
         out: out.to_path_buf(),
     };
+    let recorder = record.then(|| {
+        let setup = RunSetup::load(&root().join(SCENE), &[], Part::Run).unwrap();
+        Recorder::begin(out, &info.run_id, &setup).unwrap()
+    });
+    let tap = |node| Tap {
+        recorder: recorder.clone().unwrap(),
+        node,
+    };
+    let (mut fem, mut sph): (Box<FemLink>, Box<SphLink>) = match record {
+        true => (
+            Box::new(Recorded::new(fem, tap(Node::Fem), &info.run_id)),
+            Box::new(Recorded::new(sph, tap(Node::Sph), &info.run_id)),
+        ),
+        false => (Box::new(fem), Box::new(sph)),
+    };
     let nodes = Nodes {
-        fem: Some(&mut fem as &mut FemLink),
-        sph: Some(&mut sph as &mut SphLink),
+        fem: Some(fem.as_mut()),
+        sph: Some(sph.as_mut()),
     };
     let outcome = coordinator::run(&loaded, nodes, &info, &mut |_| std::ops::ControlFlow::Continue(()));
     assert!(outcome.summary.status.is_ok(), "{}", outcome.summary.message);
+    if let Some(r) = &recorder {
+        r.finish("ok", "", outcome.summary.steps);
+    }
     let g = loaded.scene.run.gravity[1].abs();
     let block = &loaded.scene.fluid.as_ref().unwrap().blocks[0];
     let solid = &loaded.scene.solids[0];
@@ -293,7 +316,7 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
             .trim()
     );
 
-    let statics = run_rust_twin(&out_rs);
+    let statics = run_rust_twin(&out_rs, false);
     let py = std::fs::read(out_py.join("probes.csv")).unwrap();
     let rs = std::fs::read(out_rs.join("probes.csv")).unwrap();
     assert!(py.len() > 100, "probes.csv is empty");
@@ -308,4 +331,42 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
         100.0 * err
     );
     assert!(err.abs() < 0.10, "{mean} vs {statics}");
+}
+
+/// Issue 19: the conformance test for an outside code. A run of the Rust twin, recorded in this process, is replayed
+/// with `cosim replay --exec` against the Python node: each of its answers matches the twin's within the tolerance.
+/// Byte for byte they do not quite (on 2026-11-27 the first difference was the last bit of a snapshot's kinetic
+/// energy at step 3350, a quantity no probe reads): that line is printed, not asserted.
+#[test]
+fn python_node_replays_a_trace_of_its_rust_twin() {
+    let python = python();
+    let dir = scratch("external_python_replay");
+    run_rust_twin(&dir, true);
+    let steps = json(&dir.join("summary.json"))["steps"].as_u64().unwrap();
+    let exec = format!(
+        "{} {} --timeout 60",
+        python.display(),
+        root().join("examples/python/rigid_plate_node.py").display()
+    );
+    let trace = dir.join("trace").display().to_string();
+    let replay = |tolerance: &[&str]| {
+        let mut cmd = Command::new(cosim());
+        cmd.args(["replay", &trace, "--node", "fem", "--exec", &exec])
+            .args(tolerance)
+            .env("COSIM_BIN_DIR", bin_dir());
+        let out = run_bounded(&mut cmd, LIMIT);
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (out.status.success(), said)
+    };
+    let (ok, said) = replay(&["--rtol", "1e-9", "--atol", "1e-12"]);
+    assert!(ok, "{said}");
+    assert!(
+        said.starts_with(&format!("matched {} steps (fem-node, ", steps + 1)),
+        "{said}"
+    );
+    eprintln!("byte for byte: {}", replay(&[]).1.trim());
 }

@@ -8,6 +8,7 @@ pub mod messages;
 pub mod overlap;
 pub mod run_status;
 pub mod scene;
+pub mod trace;
 pub mod validate;
 
 pub use scene::sizing;

@@ -1,0 +1,159 @@
+//! `--record`: the broker writes every message of the run to `DIR/trace/trace.bin` as it sends or receives it
+//! (format: `cosim_proto::trace`, `docs/PROTOCOL.md` §10).
+//!
+//! Each record goes to the file with one `write` call as soon as the message is sent or accepted, with no buffer in
+//! this process: a broker killed at any point (SIGKILL included) leaves every record it wrote readable, and at worst
+//! one record cut short at the end, which readers skip. It is not flushed to the disk (no fsync): a machine that
+//! loses power may lose the tail. A write that fails (a full disk) stops the recording with one error in the log;
+//! the run goes on.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use anyhow::Context;
+use cosim_proto::trace::{self, Kind, Node};
+
+use crate::setup::RunSetup;
+
+mod recorded;
+
+pub use recorded::Recorded;
+
+/// The trace's file name inside `DIR/trace/`.
+pub const FILE: &str = "trace.bin";
+
+/// What a recording cost, for its end record and the log.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Cost {
+    /// Records written.
+    pub records: u64,
+    /// Bytes written, header included.
+    pub bytes: u64,
+    /// Seconds spent encoding and writing them.
+    pub seconds: f64,
+}
+
+struct Inner {
+    file: Option<std::fs::File>,
+    path: PathBuf,
+    cost: Cost,
+}
+
+/// The open trace, shared by everything that records into it (the two node links and the broker itself).
+#[derive(Clone)]
+pub struct Recorder(Arc<Mutex<Inner>>);
+
+impl Recorder {
+    /// Create `out/trace/trace.bin` afresh (a trace of an earlier run in that folder is replaced) and write its
+    /// header.
+    pub fn create(out: &Path) -> anyhow::Result<Self> {
+        let dir = out.join("trace");
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let path = dir.join(FILE);
+        let mut file = std::fs::File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        let header = trace::header(cosim_proto::PROTOCOL_VERSION);
+        file.write_all(&header)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(Self(Arc::new(Mutex::new(Inner {
+            file: Some(file),
+            path,
+            cost: Cost {
+                bytes: header.len() as u64,
+                ..Cost::default()
+            },
+        }))))
+    }
+
+    /// Append one record. Never fails the run: a write error stops the recording and is logged once.
+    pub fn record(&self, kind: Kind, node: Node, step: u64, payload: &[u8]) {
+        let started = Instant::now();
+        let Ok(mut inner) = self.0.lock() else { return };
+        let Some(file) = inner.file.as_mut() else { return };
+        let written = match trace::encode(kind, node, step, payload) {
+            Some(bytes) => file.write_all(&bytes).map(|()| bytes.len() as u64),
+            None => Err(std::io::Error::other("a message over 4 GiB")),
+        };
+        match written {
+            Ok(n) => {
+                inner.cost.records += 1;
+                inner.cost.bytes += n;
+            }
+            Err(e) => {
+                tracing::error!(
+                    "{}: {e}; the recording stops here (what was written stays readable)",
+                    inner.path.display()
+                );
+                inner.file = None;
+            }
+        }
+        inner.cost.seconds += started.elapsed().as_secs_f64();
+    }
+
+    /// [`Recorder::create`], then the records a run starts with: the scene as the broker serves it, and the
+    /// broker's restore reply to each node the scene has (`docs/PROTOCOL.md` §10).
+    pub fn begin(out: &Path, run: &str, setup: &RunSetup) -> anyhow::Result<Self> {
+        let r = Self::create(out)?;
+        let scene = &setup.scene.scene;
+        r.record(Kind::Scene, Node::Broker, 0, scene.to_toml().as_bytes());
+        let saved = |data: Option<&Vec<u8>>| {
+            let at = setup.restart.as_ref()?;
+            Some((at.broker.step, at.broker.t, data?.clone()))
+        };
+        let nodes = [
+            (
+                !scene.solids.is_empty(),
+                cosim_proto::keys::FEM,
+                Node::Fem,
+                saved(setup.saved_fem()),
+            ),
+            (
+                scene.fluid.is_some(),
+                cosim_proto::keys::SPH,
+                Node::Sph,
+                saved(setup.saved_sph()),
+            ),
+        ];
+        for (_, topics, node, saved) in nodes.into_iter().filter(|n| n.0) {
+            let reply = crate::transport::restore_reply(run, topics, saved)?;
+            r.record(Kind::Restore, node, 0, &reply);
+        }
+        Ok(r)
+    }
+
+    /// What the recording cost so far.
+    pub fn cost(&self) -> Cost {
+        self.0.lock().map(|i| i.cost).unwrap_or_default()
+    }
+
+    /// The end record: how the run ended and what the recording cost (this record's own bytes not counted).
+    pub fn finish(&self, status: &str, message: &str, steps: u64) {
+        let cost = self.cost();
+        let end = serde_json::json!({
+            "status": status,
+            "message": message,
+            "steps": steps,
+            "records": cost.records,
+            "bytes": cost.bytes,
+            "record_seconds": cost.seconds,
+        });
+        self.record(Kind::End, Node::Broker, steps, end.to_string().as_bytes());
+    }
+}
+
+/// A recorder bound to one node's messages.
+#[derive(Clone)]
+pub struct Tap {
+    /// The trace.
+    pub recorder: Recorder,
+    /// Whose messages.
+    pub node: Node,
+}
+
+impl Tap {
+    /// Append one of this node's messages.
+    pub fn record(&self, kind: Kind, step: u64, payload: &[u8]) {
+        self.recorder.record(kind, self.node, step, payload);
+    }
+}

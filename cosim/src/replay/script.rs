@@ -1,0 +1,142 @@
+//! What a trace holds for one node, in the order it is played back: the scene, the restore reply, the registration,
+//! then each command with the answer the node gave to it.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use cosim_proto::envelope::Envelope;
+use cosim_proto::messages::StepCommand;
+use cosim_proto::trace::{self, Kind, Node, RawEnvelope, Torn};
+
+use crate::cli::ExternalNode;
+
+/// What the node answered to one command in the recorded run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Answer {
+    /// Its state (`fem/state`, `sph/state`).
+    State(Vec<u8>),
+    /// Its failure report (`fem/error`, `sph/error`).
+    Error(Vec<u8>),
+}
+
+/// One command and what came back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Exchange {
+    /// The envelope's step.
+    pub step: u64,
+    /// The command as sent.
+    pub command: Vec<u8>,
+    /// A stop command (nothing comes back).
+    pub stop: bool,
+    /// The recorded answer; `None` when the trace ends before it.
+    pub answer: Option<Answer>,
+}
+
+/// One node's part of a trace.
+#[derive(Clone, Debug)]
+pub struct Script {
+    /// The file read.
+    pub path: PathBuf,
+    /// The scene (TOML) the broker served.
+    pub scene: String,
+    /// The broker's reply to the node's restore query, as recorded.
+    pub restore: Option<Vec<u8>>,
+    /// The node's registration as received.
+    pub setup: Vec<u8>,
+    /// The commands, in the order they were sent, with their answers.
+    pub exchanges: Vec<Exchange>,
+    /// Where the file stops before its end (a run that was killed), if it does.
+    pub torn: Option<Torn>,
+    /// The end record (JSON), when the run got to write it.
+    pub end: Option<String>,
+}
+
+/// `DIR/trace` → `DIR/trace/trace.bin`; a file is taken as it is.
+pub fn trace_file(path: &Path) -> PathBuf {
+    match path.is_dir() {
+        true => path.join(contact_broker::recorder::FILE),
+        false => path.to_path_buf(),
+    }
+}
+
+/// The trace's records for `node`. Bad input (a file that is not a trace, a node the run did not have, a message
+/// that does not decode) is an error naming the file and the record.
+pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
+    let path = trace_file(path);
+    let bytes = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let who = match node {
+        ExternalNode::Fem => Node::Fem,
+        ExternalNode::Sph => Node::Sph,
+    };
+    // Only the broker's records and this node's are kept: a replay holds little more than its part of the trace.
+    let trace =
+        trace::parse_with(&bytes, |_, n| n == who || n == Node::Broker).with_context(|| path.display().to_string())?;
+    drop(bytes);
+    anyhow::ensure!(
+        trace.protocol_version == cosim_proto::PROTOCOL_VERSION,
+        "{}: recorded with protocol version {}, this build speaks {}",
+        path.display(),
+        trace.protocol_version,
+        cosim_proto::PROTOCOL_VERSION
+    );
+    let mut scene = None;
+    let mut restore = None;
+    let mut setup = None;
+    let mut end = None;
+    let mut exchanges: Vec<Exchange> = Vec::new();
+    for (i, r) in trace.records.into_iter().enumerate() {
+        let bad = |why: &str| {
+            anyhow::anyhow!(
+                "{}: record {i} ({} of step {}): {why}",
+                path.display(),
+                r.kind.name(),
+                r.step
+            )
+        };
+        match (r.kind, r.node) {
+            (Kind::Scene, _) => scene = Some(String::from_utf8(r.payload.clone()).map_err(|_| bad("not UTF-8"))?),
+            (Kind::End, _) => end = Some(String::from_utf8_lossy(&r.payload).into_owned()),
+            (_, n) if n != who => {}
+            (Kind::Restore, _) => restore = Some(r.payload),
+            (Kind::Setup, _) => setup = Some(r.payload),
+            (Kind::Command, _) => {
+                let raw = RawEnvelope::split(&r.payload).ok_or_else(|| bad("not an envelope"))?;
+                let env =
+                    Envelope::<StepCommand>::decode(&r.payload, raw.run, "command").map_err(|e| bad(&e.to_string()))?;
+                exchanges.push(Exchange {
+                    step: env.step,
+                    command: r.payload,
+                    stop: env.body.stop,
+                    answer: None,
+                });
+            }
+            (Kind::State | Kind::Error, _) => {
+                // The answer belongs to the last command sent for its step.
+                let answer = match r.kind {
+                    Kind::State => Answer::State(r.payload),
+                    _ => Answer::Error(r.payload),
+                };
+                if let Some(x) = exchanges.iter_mut().rev().find(|x| x.step == r.step && !x.stop) {
+                    x.answer.get_or_insert(answer);
+                }
+            }
+        }
+    }
+    let what = node.program();
+    let scene = scene.ok_or_else(|| anyhow::anyhow!("{}: no scene record (not a whole trace)", path.display()))?;
+    let setup = setup.ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: {what} never registered in the recorded run (the run has no such node, or it died first)",
+            path.display()
+        )
+    })?;
+    Ok(Script {
+        path,
+        scene,
+        restore,
+        setup,
+        exchanges,
+        torn: trace.torn,
+        end,
+    })
+}
