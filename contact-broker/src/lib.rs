@@ -11,6 +11,7 @@ pub mod interface;
 pub mod link;
 pub mod output;
 pub mod probes;
+pub mod remote_control;
 pub mod setup;
 pub mod summary;
 pub mod transport;

@@ -80,6 +80,9 @@ fn table(doc: &serde_json::Value) -> String {
             if let Some(stats) = s["extra"].get("contact_stats") {
                 out += &format!("{:<15} contact_stats {stats}\n", "");
             }
+            if let Some(p) = s["extra"].get("paused").and_then(|p| p.as_str()) {
+                out += &format!("{:<15} {p}\n", "");
+            }
             if let Some(m) = s["message"].as_str().filter(|m| !m.is_empty()) {
                 out += &format!("{:<15} {m}\n", "");
             }
@@ -88,8 +91,36 @@ fn table(doc: &serde_json::Value) -> String {
     out
 }
 
+/// `cosim inspect ID --particle P | --node N`: one particle's or node's state as JSON (`look.rs`).
+fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    let how = crate::join::JoinArgs {
+        connect: args.connect.clone(),
+        client: args.client,
+        zenoh_config: args.zenoh_config.clone(),
+        timeout: args.timeout.max(10.0),
+    };
+    let (session, connect) = crate::join::join(&args.id, &how)?;
+    let look = match crate::look::fetch(&session, &args.id, Duration::from_secs_f64(how.timeout)) {
+        Ok(look) => look,
+        Err(e) => {
+            eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
+            return Ok(ExitCode::from(1));
+        }
+    };
+    let doc = match (args.particle, args.node) {
+        (Some(p), _) => crate::look::particle(&look, p)?,
+        (None, Some(n)) => crate::look::node(&look, n)?,
+        (None, None) => unreachable!("inspect_one is called with --particle or --node"),
+    };
+    println!("{doc:#}");
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Run `cosim inspect`; `Err` for bad input (exit 2).
 pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    if args.particle.is_some() || args.node.is_some() {
+        return inspect_one(args);
+    }
     let (connect, client, zenoh_config) = match &args.connect {
         Some(c) => (c.clone(), args.client, args.zenoh_config.clone()),
         None => match registry::lookup(&args.id) {

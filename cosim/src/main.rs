@@ -27,6 +27,8 @@ fn main() -> ExitCode {
         Command::BenchRun(args) => cosim::bench::bench_run(&args),
         Command::Inspect(args) => cosim::inspect::inspect(&args),
         Command::Router(args) => cosim::router::router(&args),
+        Command::Ctl(args) => cosim::ctl::ctl(&args),
+        Command::Snapshot(args) => cosim::snapshot::snapshot(&args),
     };
     match result {
         Ok(code) => code,
