@@ -170,10 +170,14 @@ pub fn contacts(look: &Look) -> Vec<ContactRow> {
     rows
 }
 
+/// An interface segment as a point sees it: its index, its nodes, the point's closest point on it and its outward
+/// unit normal.
+type Nearest = (usize, [u32; 2], [f64; 2], [f64; 2]);
+
 /// The interface segment nearest `p` (positions `x` of the mesh's nodes): its index, nodes, the closest point on
 /// it and its outward unit normal (dy, −dx)/L (`fem/mesh` runs boundaries counter-clockwise).
-fn nearest_segment(mesh: &FemMesh, x: &[[f64; 2]], p: [f64; 2]) -> Option<(usize, [u32; 2], [f64; 2], [f64; 2])> {
-    let mut best: Option<(f64, (usize, [u32; 2], [f64; 2], [f64; 2]))> = None;
+fn nearest_segment(mesh: &FemMesh, x: &[[f64; 2]], p: [f64; 2]) -> Option<Nearest> {
+    let mut best: Option<(f64, Nearest)> = None;
     for (k, s) in mesh.interface.iter().enumerate() {
         let (Some(&a), Some(&b)) = (x.get(s.a as usize), x.get(s.b as usize)) else {
             continue;

@@ -201,7 +201,7 @@ fn drive(
     if let Err(e) = stepping() {
         // `--break unstable`: a blow-up pauses the run where it happened, every process alive, until it is stopped.
         let unstable = e.downcast_ref::<LinkError>().map(LinkError::status) == Some(RunStatus::Unstable);
-        if let (true, Some(debugger)) = (unstable, debugger.as_deref_mut()) {
+        if let (true, Some(debugger)) = (unstable, debugger) {
             let max_penetration = summary.contact_stats.max_penetration;
             let mut halt = Halt::new(clock.step, clock.t, max_penetration, &contact.pending, nodes);
             debugger.on_unstable(&mut halt, &format!("{e:#}").replace('\n', " "));
