@@ -240,3 +240,106 @@ impl<'c> Debugger<'c> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::VecDeque;
+
+    use super::*;
+
+    /// Commands handed out one per call, the pauses shown and the answers given.
+    #[derive(Default)]
+    struct Script {
+        commands: VecDeque<ControlCommand>,
+        shown: Vec<String>,
+        answers: Vec<ControlReply>,
+    }
+
+    impl Controller for Script {
+        fn next(&mut self, _halt: &mut Halt<'_, '_>, wait: Option<Duration>) -> Option<ControlCommand> {
+            // A running run is only told to pause; the rest comes while it is paused.
+            if wait.is_none() && self.commands.front() != Some(&ControlCommand::Pause) {
+                return None;
+            }
+            let next = self.commands.pop_front();
+            // A paused run with nothing left to say would wait for ever: a script must end it.
+            assert!(next.is_some() || wait.is_none(), "paused with no command left");
+            next
+        }
+        fn answer(&mut self, reply: ControlReply) {
+            self.answers.push(reply);
+        }
+        fn show(&mut self, line: &str) {
+            self.shown.push(line.to_string());
+        }
+    }
+
+    /// Steps 1, 2, … at 0.01 s each through the debugger, until it stops the run or `last` is done; the step it
+    /// stopped at, if it did.
+    fn drive(debugger: &mut Debugger<'_>, last: u64) -> Option<u64> {
+        let pending = Corrections::default();
+        for step in 1..=last {
+            let mut nodes = Nodes { fem: None, sph: None };
+            let mut halt = Halt::new(step, 0.01 * step as f64, 0.0, &pending, &mut nodes);
+            if debugger.after_step(&mut halt).is_err() {
+                return Some(step);
+            }
+        }
+        None
+    }
+
+    #[test]
+    fn a_break_pauses_once_and_step_n_takes_exactly_n_steps() {
+        let mut script = Script {
+            // Paused at step 3 (t >= 0.025): 2 steps, then resume; nothing more to say after.
+            commands: [ControlCommand::Step { steps: 2 }, ControlCommand::Resume].into(),
+            ..Script::default()
+        };
+        let mut debugger = Debugger::new(Some(BreakCondition::TimeAtLeast(0.025)), &mut script);
+        assert_eq!(drive(&mut debugger, 10), None);
+        assert_eq!(
+            script.shown,
+            ["paused at step 3: t>=0.025", "", "paused at step 5: `step 2` done", ""]
+        );
+        assert_eq!(script.answers.len(), 2);
+        assert!(script.answers.iter().all(|a| a.ok && a.paused.is_empty()));
+        assert_eq!((script.answers[0].step, script.answers[1].step), (3, 5));
+    }
+
+    #[test]
+    fn stop_ends_the_run_and_step_zero_is_refused() {
+        let mut script = Script {
+            commands: [
+                ControlCommand::Pause,
+                ControlCommand::Step { steps: 0 },
+                ControlCommand::Status,
+                ControlCommand::Stop,
+            ]
+            .into(),
+            ..Script::default()
+        };
+        let mut debugger = Debugger::new(None, &mut script);
+        assert_eq!(drive(&mut debugger, 10), Some(1));
+        let oks: Vec<bool> = script.answers.iter().map(|a| a.ok).collect();
+        assert_eq!(oks, [true, false, true, true]);
+        assert_eq!(script.shown, ["paused at step 1: paused by `cosim ctl pause`"]);
+    }
+
+    #[test]
+    fn an_unstable_run_pauses_only_with_break_unstable_and_cannot_go_on() {
+        let pending = Corrections::default();
+        let mut nodes = Nodes { fem: None, sph: None };
+        let mut halt = Halt::new(7, 0.07, 0.0, &pending, &mut nodes);
+        let mut quiet = Script::default();
+        Debugger::new(Some(BreakCondition::Step(3)), &mut quiet).on_unstable(&mut halt, "blew up");
+        assert!(quiet.shown.is_empty() && quiet.answers.is_empty());
+        let mut script = Script {
+            commands: [ControlCommand::Resume, ControlCommand::Stop].into(),
+            ..Script::default()
+        };
+        Debugger::new(Some(BreakCondition::Unstable), &mut script).on_unstable(&mut halt, "blew up");
+        assert_eq!(script.shown, ["paused at step 7: unstable: blew up"]);
+        let oks: Vec<bool> = script.answers.iter().map(|a| a.ok).collect();
+        assert_eq!(oks, [false, true]);
+    }
+}
