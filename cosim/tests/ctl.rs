@@ -101,6 +101,14 @@ fn break_snapshot_step_and_resume_leave_the_run_bit_identical() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert_eq!(bad.status.code(), Some(2), "{err}");
     assert!(err.contains("`t>0.1`") && err.contains("unstable"), "{err}");
+    let scene = root().join("cosim/tests/data/fluid_unstable.toml");
+    let in_process = cosim_run(
+        &["run", scene.to_str().unwrap(), "--in-process", "--break", "unstable"],
+        Duration::from_secs(20),
+    );
+    let err = String::from_utf8_lossy(&in_process.stderr);
+    assert_eq!(in_process.status.code(), Some(2), "{err}");
+    assert!(err.contains("--in-process"), "{err}");
 
     // The run never paused.
     let reference = dir.join("reference");
