@@ -42,7 +42,7 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
             ),
             None => anyhow::bail!(
                 "run `{id}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
-                 elsewhere (in-process runs cannot be joined)",
+                 elsewhere (an in-process run cannot be reached from another process)",
                 registry::dir().display()
             ),
         },
@@ -58,8 +58,9 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
     base_config(base)?;
     let session = match client {
         true => open_client_from(base, std::slice::from_ref(&connect), timeout_ms),
-        // Listening too, on a wildcard address, as `cosim inspect` does: the nodes learn of this process through
-        // the broker (gossip) and connect to it, which is how their answers reach it.
+        // Listening too: the nodes learn of this process through the broker (gossip) and connect to it, which is
+        // how their answers reach it (peers do not forward for each other). Zenoh gossips the addresses of a
+        // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for this process's few seconds only).
         false => open_listening_from(
             base,
             &["tcp/0.0.0.0:0".to_string()],
