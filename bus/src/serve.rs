@@ -297,7 +297,7 @@ fn serve_session<C: NodeCore>(
             Ok(Some(state)) => state,
             Ok(None) => return Ok(()),
             // A blow-up is reported at once, and the node stays to be looked at (`cosim run --break unstable`,
-            // `docs/PROTOCOL.md` §10): it answers checkpoint queries with the state it blew up in until the broker
+            // `docs/PROTOCOL.md` §11): it answers checkpoint queries with the state it blew up in until the broker
             // goes or says stop.
             Err(failure) if failure.unstable => {
                 let message = format!("{failure:#}").replace('\n', " ");

@@ -64,7 +64,7 @@ struct Args {
     #[arg(long, value_name = "FILE")]
     zenoh_config: Option<PathBuf>,
     /// Pause the run, every process alive, when CONDITION first holds (`t>=SECONDS`, `step=N`,
-    /// `max_penetration>METRES`, `unstable`); `cosim ctl` goes on from there (`docs/PROTOCOL.md` §10).
+    /// `max_penetration>METRES`, `unstable`); `cosim ctl` goes on from there (`docs/PROTOCOL.md` §11).
     #[arg(long = "break", value_name = "CONDITION")]
     break_on: Option<BreakCondition>,
     /// Mode written into summary.json.
@@ -248,7 +248,7 @@ fn serve(
         }
         ControlFlow::Continue(())
     };
-    // `cosim ctl` and `cosim snapshot` (`docs/PROTOCOL.md` §10), answered between two steps.
+    // `cosim ctl` and `cosim snapshot` (`docs/PROTOCOL.md` §11), answered between two steps.
     let mut heartbeat = Instant::now();
     let stopping = interrupt.clone();
     let must_stop = move || -> Option<String> {

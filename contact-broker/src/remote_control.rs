@@ -1,4 +1,4 @@
-//! The broker's side of `cosim ctl` and `cosim snapshot` (`docs/PROTOCOL.md` §10): the queryables
+//! The broker's side of `cosim ctl` and `cosim snapshot` (`docs/PROTOCOL.md` §11): the queryables
 //! `cosim/<run>/broker/control` (JSON commands: pause, resume, step, stop, status) and `cosim/<run>/broker/state`
 //! (the run's state between two steps), answered on the coordinator's thread between two steps
 //! ([`Controller`]), so that a command never lands in the middle of a step.

@@ -1,5 +1,5 @@
 //! `cosim ctl RUN pause|resume|step [N]|stop|status`: drive a live run through its broker's control queryable
-//! (`cosim/<run>/broker/control`, `docs/PROTOCOL.md` §10). The broker takes a command between two steps and
+//! (`cosim/<run>/broker/control`, `docs/PROTOCOL.md` §11). The broker takes a command between two steps and
 //! answers with where the run is; `step N` waits here until the N steps are taken and the run paused again.
 
 use std::process::ExitCode;

@@ -1,5 +1,5 @@
 //! Looking inside a live run (`cosim snapshot`, `cosim inspect RUN --particle ID | --node ID`): its state between
-//! two steps from its broker (`cosim/<run>/broker/state`, `docs/PROTOCOL.md` §10: every node's checkpoint and the
+//! two steps from its broker (`cosim/<run>/broker/state`, `docs/PROTOCOL.md` §11: every node's checkpoint and the
 //! last contact pass's corrections), read here with the nodes' own code, and the scene from the broker's `scene`
 //! queryable. Reading changes nothing in the run: the nodes answer a checkpoint query from their state as it is.
 

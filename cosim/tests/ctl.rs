@@ -1,4 +1,4 @@
-//! Pause, step, resume, break and look inside a live run (issue 19; `docs/PROTOCOL.md` §10): `cosim run --break
+//! Pause, step, resume, break and look inside a live run (issue 19; `docs/PROTOCOL.md` §11): `cosim run --break
 //! t>=T` pauses the coarse gate within one step of T with every process alive; `cosim snapshot` writes its frames
 //! there; `cosim ctl step 10` takes exactly 10 steps; `cosim inspect --particle/--node` print one particle's and one
 //! node's state; `cosim ctl resume` lets it finish, and its probes and frames are byte-identical to a run never

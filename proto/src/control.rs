@@ -1,4 +1,4 @@
-//! Controlling a live run (`docs/PROTOCOL.md` §10): the break conditions of `cosim run --break`, the commands of
+//! Controlling a live run (`docs/PROTOCOL.md` §11): the break conditions of `cosim run --break`, the commands of
 //! `cosim ctl` (pause, resume, step, stop) with the broker's answer, and the state a paused run hands out for
 //! `cosim snapshot` and `cosim inspect --particle/--node`.
 //!

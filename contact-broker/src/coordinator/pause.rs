@@ -1,5 +1,5 @@
 //! Pausing a run between two steps (`cosim run --break CONDITION`, `cosim ctl RUN pause|resume|step N|stop`;
-//! `docs/PROTOCOL.md` §10). The coordinator calls [`Debugger::after_step`] once every node answered a step, its
+//! `docs/PROTOCOL.md` §11). The coordinator calls [`Debugger::after_step`] once every node answered a step, its
 //! contact pass ran and its outputs were written: the nodes then wait for their next command, so a pause holds the
 //! whole run where it is, every process alive, and going on sends exactly the commands a run never paused sends —
 //! pausing changes no bit of the run. Where the commands come from (a zenoh queryable in the broker) is the
