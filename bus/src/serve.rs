@@ -130,21 +130,23 @@ pub fn serve<C: NodeCore>(
         .congestion_control(CongestionControl::Block)
         .wait()
         .map_err(zerr)?;
+    let reported = std::cell::Cell::new(false);
     let report = |status: RunStatus, message: String| {
         let body = NodeError {
             status: status.as_str().into(),
             message,
         };
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
+        reported.set(true);
     };
-    let result = serve_session(&session, opts, topics, build, &board);
+    let result = serve_session(&session, opts, topics, build, &board, &report);
     board.update(|s| {
         s.health = if result.is_ok() { "finished" } else { "failed" }.into();
         if let Err(e) = &result {
             s.message = format!("{e:#}").replace('\n', " ");
         }
     });
-    if let Err(e) = &result {
+    if let (Err(e), false) = (&result, reported.get()) {
         let unstable = e.downcast_ref::<Failure>().is_some_and(|f| f.unstable);
         report(
             if unstable {
@@ -166,6 +168,7 @@ fn serve_session<C: NodeCore>(
     topics: NodeTopics,
     build: impl FnOnce(&Scene) -> Result<C, Failure>,
     board: &Board,
+    report: &dyn Fn(RunStatus, String),
 ) -> anyhow::Result<()> {
     let run = opts.run.as_str();
     // The command subscription exists before the node registers, so the first command cannot be missed.
@@ -227,9 +230,9 @@ fn serve_session<C: NodeCore>(
     let mut energy_at = idle_since.checked_sub(ENERGY_EVERY).unwrap_or(idle_since);
     // The last command answered and its answer, to answer it again if it comes again.
     let mut last: Option<(Vec<u8>, ZBytes)> = None;
-    loop {
+    // Between two steps: the state after step `expected - 1`, before the corrections of the next.
+    let answer_checkpoints = |core: &C, expected: u64, t: f64| {
         while let Ok(Some(query)) = checkpoints.try_recv() {
-            // Between two steps: the state after step `expected - 1`, before the corrections of the next.
             let reply = match core.checkpoint() {
                 Some(data) => {
                     let body = NodeCheckpoint {
@@ -247,6 +250,9 @@ fn serve_session<C: NodeCore>(
                 tracing::error!("checkpoint query: {e}");
             }
         }
+    };
+    loop {
+        answer_checkpoints(&core, expected, t);
         let Some(sample) = commands.recv_timeout(Duration::from_millis(50)).map_err(zerr)? else {
             while let Ok(Some(s)) = broker_alive.try_recv() {
                 if s.kind() == SampleKind::Delete {
@@ -287,8 +293,37 @@ fn serve_session<C: NodeCore>(
         let dt = env.body.dt;
         let computing = std::time::Instant::now();
         let waited = (computing - idle_since).as_secs_f64();
-        let Some(state) = core.handle(&env.body)? else {
-            return Ok(());
+        let state = match core.handle(&env.body) {
+            Ok(Some(state)) => state,
+            Ok(None) => return Ok(()),
+            // A blow-up is reported at once, and the node stays to be looked at (`cosim run --break unstable`,
+            // `docs/PROTOCOL.md` §11): it answers checkpoint queries with the state it blew up in until the broker
+            // goes or says stop.
+            Err(failure) if failure.unstable => {
+                let message = format!("{failure:#}").replace('\n', " ");
+                board.update(|s| {
+                    s.health = "failed".into();
+                    s.message = message.clone();
+                });
+                report(RunStatus::Unstable, message);
+                loop {
+                    answer_checkpoints(&core, expected, t);
+                    if let Ok(Some(sample)) = commands.recv_timeout(Duration::from_millis(50)) {
+                        let stop = Envelope::<StepCommand>::decode(&sample.payload().to_bytes(), run, topics.command)
+                            .is_ok_and(|e| e.body.stop);
+                        if stop {
+                            break;
+                        }
+                    }
+                    let gone = std::iter::from_fn(|| broker_alive.try_recv().ok().flatten())
+                        .any(|s| s.kind() == SampleKind::Delete);
+                    if gone {
+                        break;
+                    }
+                }
+                return Err(failure.into());
+            }
+            Err(failure) => return Err(failure.into()),
         };
         t = if dt > 0.0 { env.t + dt } else { t.max(env.t) };
         board.step(env.step, t, dt, computing.elapsed().as_secs_f64(), waited);

@@ -12,6 +12,7 @@ pub mod link;
 pub mod output;
 pub mod probes;
 pub mod recorder;
+pub mod remote_control;
 pub mod setup;
 pub mod summary;
 pub mod transport;

@@ -10,14 +10,17 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
+use contact_broker::coordinator::pause::Debugger;
 use contact_broker::coordinator::{Nodes, Progress, RunInfo};
 use contact_broker::link::{FemLink, NodeLink, SphLink};
 use contact_broker::recorder::{Recorder, Tap};
+use contact_broker::remote_control::RemoteControl;
 use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, SummaryBuilder};
 use contact_broker::transport::{self, ZenohLink};
 use cosim_bus::interrupt::Interrupt;
 use cosim_bus::status::{serve_status, Board};
+use cosim_proto::control::BreakCondition;
 use cosim_proto::keys::{key, topic, valid_run_id};
 use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
 use cosim_proto::sizing::Part;
@@ -65,6 +68,10 @@ struct Args {
     /// Keep every message of the run in `DIR/trace/trace.bin` (`docs/PROTOCOL.md` §10), for `cosim replay`.
     #[arg(long)]
     record: bool,
+    /// Pause the run, every process alive, when CONDITION first holds (`t>=SECONDS`, `step=N`,
+    /// `max_penetration>METRES`, `unstable`); `cosim ctl` goes on from there (`docs/PROTOCOL.md` §11).
+    #[arg(long = "break", value_name = "CONDITION")]
+    break_on: Option<BreakCondition>,
     /// Mode written into summary.json.
     #[arg(long, default_value = "processes")]
     mode: String,
@@ -263,7 +270,35 @@ fn serve(
         }
         ControlFlow::Continue(())
     };
-    let outcome = setup.run(nodes, &info, &mut report);
+    // `cosim ctl` and `cosim snapshot` (`docs/PROTOCOL.md` §11), answered between two steps.
+    let mut heartbeat = Instant::now();
+    let stopping = interrupt.clone();
+    let must_stop = move || -> Option<String> {
+        if stopping.arrived() {
+            return Some(cosim_bus::interrupt::REASON.to_string());
+        }
+        // While paused the launcher still hears from the broker, so a launcher gone stops a paused run too.
+        if heartbeat.elapsed() >= Duration::from_millis(200) {
+            heartbeat = Instant::now();
+            if let Err(e) = emit(serde_json::json!({"event": "paused"})) {
+                return Some(format!("the launcher stopped reading this broker's progress ({e})"));
+            }
+        }
+        None
+    };
+    let showing = board.clone();
+    let show = move |line: &str| {
+        showing.update(|s| match line.is_empty() {
+            true => drop(s.extra.remove("paused")),
+            false => drop(s.extra.insert("paused".into(), line.into())),
+        });
+        if !line.is_empty() {
+            tracing::info!("{line}");
+        }
+    };
+    let mut control = RemoteControl::declare(&session, &args.run, Box::new(must_stop), Box::new(show))?;
+    let mut debugger = Debugger::new(args.break_on, &mut control);
+    let outcome = setup.run_debug(nodes, &info, &mut report, &mut debugger);
     if let Some(r) = recorder {
         let s = &outcome.summary;
         r.finish(s.status.as_str(), &s.message, s.steps);

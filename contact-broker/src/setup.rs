@@ -9,6 +9,7 @@ use cosim_proto::scene::LoadedScene;
 use cosim_proto::sizing::Part;
 
 use crate::checkpoint::{self, Restart};
+use crate::coordinator::pause::Debugger;
 use crate::coordinator::{self, Checkpoints, Control, Nodes, Outcome, Progress, RunInfo};
 
 /// A run ready to start: its scene and its checkpoints.
@@ -66,5 +67,21 @@ impl RunSetup {
             restart: self.restart.as_ref().map(|r| r.broker.clone()),
         };
         coordinator::run_with(&self.scene, nodes, info, &plan, progress)
+    }
+
+    /// [`RunSetup::run`], paused and driven by `debugger` between two steps (`cosim run --break`, `cosim ctl`):
+    /// [`coordinator::run_debug`].
+    pub fn run_debug(
+        &self,
+        nodes: Nodes<'_>,
+        info: &RunInfo,
+        progress: &mut dyn FnMut(Progress) -> Control,
+        debugger: &mut Debugger<'_>,
+    ) -> Outcome {
+        let plan = Checkpoints {
+            interval: self.checkpoint_interval,
+            restart: self.restart.as_ref().map(|r| r.broker.clone()),
+        };
+        coordinator::run_debug(&self.scene, nodes, info, &plan, progress, Some(debugger))
     }
 }

@@ -36,6 +36,53 @@ pub enum Command {
     /// One case of `cosim bench`: `cosim run` that also writes its peak resident memory and CPU time to a file.
     #[command(hide = true)]
     BenchRun(BenchRunArgs),
+    /// Pause, resume, step or stop a live run (`cosim ctl RUN pause|resume|step [N]|stop|status`).
+    Ctl(CtlArgs),
+    /// Write the current state of a live run (particles, mesh, the last contact pass) as ParaView frames.
+    Snapshot(SnapshotArgs),
+}
+
+/// `cosim ctl`.
+#[derive(Args, Debug, Clone)]
+pub struct CtlArgs {
+    /// Run id.
+    pub id: String,
+    /// What to do.
+    #[arg(value_enum)]
+    pub action: CtlAction,
+    /// Steps to take, with `step` (default 1).
+    pub steps: Option<u64>,
+    /// How to reach the run.
+    #[command(flatten)]
+    pub join: crate::join::JoinArgs,
+}
+
+/// What `cosim ctl` asks of a run.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CtlAction {
+    /// Pause after the step in progress (every process stays alive).
+    Pause,
+    /// Go on from a pause.
+    Resume,
+    /// Take N steps (default 1), then pause again; waits until they are taken.
+    Step,
+    /// End the run here, its outputs written (as Ctrl-C does).
+    Stop,
+    /// Say where the run is and whether it is paused.
+    Status,
+}
+
+/// `cosim snapshot`.
+#[derive(Args, Debug, Clone)]
+pub struct SnapshotArgs {
+    /// Run id.
+    pub id: String,
+    /// Folder to write the frames into (`DIR/frames/`).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// How to reach the run.
+    #[command(flatten)]
+    pub join: crate::join::JoinArgs,
 }
 
 /// `cosim run`.
@@ -88,6 +135,10 @@ pub struct RunArgs {
     /// `cosim replay` (format: `docs/PROTOCOL.md` §10).
     #[arg(long)]
     pub record: bool,
+    /// Pause the run, every process alive, when CONDITION first holds: `t>=SECONDS`, `step=N`,
+    /// `max_penetration>METRES` or `unstable` (a blow-up pauses instead of ending the run); go on with `cosim ctl`.
+    #[arg(long = "break", value_name = "CONDITION")]
+    pub break_on: Option<cosim_proto::control::BreakCondition>,
 }
 
 /// A node an outside program can take the place of.
@@ -212,6 +263,14 @@ pub struct InspectArgs {
     /// Seconds between refreshes of the table.
     #[arg(long, default_value_t = 1.0)]
     pub interval: f64,
+    /// Print one fluid particle's state (position, velocity, density, pressure, mass, neighbours, last contact
+    /// correction) as JSON and exit.
+    #[arg(long, value_name = "ID", conflicts_with = "node")]
+    pub particle: Option<u32>,
+    /// Print one FE node's state (position, velocity, displacement, interface segments, last contact correction)
+    /// as JSON and exit.
+    #[arg(long, value_name = "ID")]
+    pub node: Option<u32>,
 }
 
 /// `cosim router`.

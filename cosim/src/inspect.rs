@@ -5,11 +5,9 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use cosim_bus::session::{base_config, open_client_from, open_listening_from};
 use cosim_bus::status::query_all;
 
 use crate::cli::InspectArgs;
-use crate::registry;
 
 /// One document: `{"run": ID, "nodes": {"contact-broker": {...}, "fem-node": {...}, "sph-node": {...}}}`.
 fn document(run: &str, answers: &[(String, String)]) -> serde_json::Value {
@@ -80,6 +78,9 @@ fn table(doc: &serde_json::Value) -> String {
             if let Some(stats) = s["extra"].get("contact_stats") {
                 out += &format!("{:<15} contact_stats {stats}\n", "");
             }
+            if let Some(p) = s["extra"].get("paused").and_then(|p| p.as_str()) {
+                out += &format!("{:<15} {p}\n", "");
+            }
             if let Some(m) = s["message"].as_str().filter(|m| !m.is_empty()) {
                 out += &format!("{:<15} {m}\n", "");
             }
@@ -88,44 +89,43 @@ fn table(doc: &serde_json::Value) -> String {
     out
 }
 
+/// How `cosim inspect` reaches the run (`join.rs`), waiting `timeout` seconds.
+fn join_args(args: &InspectArgs, timeout: f64) -> crate::join::JoinArgs {
+    crate::join::JoinArgs {
+        connect: args.connect.clone(),
+        client: args.client,
+        zenoh_config: args.zenoh_config.clone(),
+        timeout,
+    }
+}
+
+/// `cosim inspect ID --particle P | --node N`: one particle's or node's state as JSON (`look.rs`).
+fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    // A state is a checkpoint of every node: it may take longer than a status.
+    let how = join_args(args, args.timeout.max(10.0));
+    let (session, connect) = crate::join::join(&args.id, &how)?;
+    let look = match crate::look::fetch(&session, &args.id, Duration::from_secs_f64(how.timeout)) {
+        Ok(look) => look,
+        Err(e) => {
+            eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
+            return Ok(ExitCode::from(1));
+        }
+    };
+    let doc = match (args.particle, args.node) {
+        (Some(p), _) => crate::look::particle(&look, p)?,
+        (None, Some(n)) => crate::look::node(&look, n)?,
+        (None, None) => unreachable!("inspect_one is called with --particle or --node"),
+    };
+    println!("{doc:#}");
+    Ok(ExitCode::SUCCESS)
+}
+
 /// Run `cosim inspect`; `Err` for bad input (exit 2).
 pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
-    let (connect, client, zenoh_config) = match &args.connect {
-        Some(c) => (c.clone(), args.client, args.zenoh_config.clone()),
-        None => match registry::lookup(&args.id) {
-            Some(e) => (
-                e.connect,
-                e.client || args.client,
-                args.zenoh_config.clone().or(e.zenoh_config),
-            ),
-            None => anyhow::bail!(
-                "run `{}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
-                 elsewhere (in-process runs have no status to inspect)",
-                args.id,
-                registry::dir().display()
-            ),
-        },
-    };
-    let timeout_ms = (args.timeout * 1000.0) as u64;
-    let base = zenoh_config.as_deref();
-    // A bad config file is its own error, not "cannot reach the run".
-    base_config(base)?;
-    let session = match client {
-        true => open_client_from(base, std::slice::from_ref(&connect), timeout_ms),
-        // Listening too: the nodes learn of the inspector through the broker (gossip) and connect to it, which is
-        // how their status reaches it (peers do not forward for each other). Zenoh gossips the addresses of a
-        // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for the inspector's few seconds only).
-        false => open_listening_from(
-            base,
-            &["tcp/0.0.0.0:0".to_string()],
-            std::slice::from_ref(&connect),
-            timeout_ms,
-        )
-        .map(|(s, _)| s),
+    if args.particle.is_some() || args.node.is_some() {
+        return inspect_one(args);
     }
-    .map_err(|e| anyhow::anyhow!("cannot reach run `{}` at {connect}: {e:#}", args.id))?;
-    // Let zenoh learn the run's queryables (gossip) before the first question.
-    std::thread::sleep(Duration::from_millis(1500));
+    let (session, connect) = crate::join::join(&args.id, &join_args(args, args.timeout))?;
     let timeout = Duration::from_secs_f64(args.timeout);
     if args.once {
         let answers = query_all(&session, &args.id, timeout)?;

@@ -213,6 +213,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if args.record {
         broker_args.push("--record".into());
     }
+    if let Some(condition) = &args.break_on {
+        broker_args.extend(["--break".into(), condition.to_string()]);
+    }
     // The zenoh config file (credentials, certificates) goes to every process started.
     let zenoh_config: Vec<String> = match &args.zenoh_config {
         Some(f) => vec!["--zenoh-config".into(), f.display().to_string()],

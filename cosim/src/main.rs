@@ -28,6 +28,8 @@ fn main() -> ExitCode {
         Command::Inspect(args) => cosim::inspect::inspect(&args),
         Command::Router(args) => cosim::router::router(&args),
         Command::Replay(args) => cosim::replay::replay(&args),
+        Command::Ctl(args) => cosim::ctl::ctl(&args),
+        Command::Snapshot(args) => cosim::snapshot::snapshot(&args),
     };
     match result {
         Ok(code) => code,

@@ -73,6 +73,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             args.wait_external
         );
     }
+    if let (Some(condition), true) = (&args.break_on, args.in_process) {
+        anyhow::bail!(
+            "--break {condition}: a paused run is driven from another process (`cosim ctl`), so it needs processes \
+             mode (drop --in-process)"
+        );
+    }
     if let (Some(node), true) = (
         args.external,
         args.checkpoint_interval.is_some() || args.restart.is_some(),

@@ -40,6 +40,10 @@ pub mod topic {
     pub const FEM_RESTORE: &str = "fem/restore";
     /// Broker queryable: the state the SPH node restarts from.
     pub const SPH_RESTORE: &str = "sph/restore";
+    /// Broker queryable: `cosim ctl` commands (pause, resume, step, stop), JSON (`crate::control`).
+    pub const BROKER_CONTROL: &str = "broker/control";
+    /// Broker queryable: the run's state between two steps, for `cosim snapshot` and `cosim inspect --particle`.
+    pub const BROKER_STATE: &str = "broker/state";
     /// Every status queryable of a run (`cosim/<run>/*/status`).
     pub const ANY_STATUS: &str = "*/status";
 }

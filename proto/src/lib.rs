@@ -2,6 +2,7 @@
 //! FEM–SPH co-simulation. Nothing here does I/O beyond reading a scene file.
 #![warn(missing_docs)]
 
+pub mod control;
 pub mod envelope;
 pub mod keys;
 pub mod messages;

@@ -35,6 +35,29 @@ pub struct SphCheckpoint {
     pub sensors: SensorLog,
 }
 
+impl SphCheckpoint {
+    /// The state in [`SphCore::checkpoint`]'s bytes, read as it is, without the checks a restore makes (a state
+    /// that blew up is read too): for looking at a live run (`cosim snapshot`, `cosim inspect --particle`).
+    pub fn decode(data: &[u8]) -> Result<Self, SphError> {
+        let options = bincode::DefaultOptions::new().with_fixint_encoding();
+        let invalid = |message: String| SphError::InvalidParameter {
+            name: "checkpoint",
+            message,
+        };
+        let (tag, version, saved): (String, u32, SphCheckpoint) = options
+            .reject_trailing_bytes()
+            .deserialize(data)
+            .map_err(|e| invalid(format!("not a fluid node's state: {e}")))?;
+        if (tag.as_str(), version) != CHECKPOINT_TAG {
+            return Err(invalid(format!(
+                "holds `{tag}` version {version}, this build reads `{}` version {}",
+                CHECKPOINT_TAG.0, CHECKPOINT_TAG.1
+            )));
+        }
+        Ok(saved)
+    }
+}
+
 /// The solver of `fluid.solver`.
 pub fn solver_from_scene(scene: &Scene) -> Result<Box<dyn FluidSolver>, SphError> {
     let spec = setup::fluid_spec_any(scene)?;

@@ -21,6 +21,7 @@ mod checkpointing;
 mod contact_pass;
 mod exchange;
 mod inputs;
+pub mod pause;
 mod progress;
 mod sampling;
 mod step_time;
@@ -29,6 +30,7 @@ use checkpointing::{RunState, Schedule};
 use contact_pass::ContactPass;
 use exchange::check_registrations;
 pub use inputs::{Checkpoints, Nodes, RunInfo};
+use pause::{Debugger, Halt};
 pub use progress::{Control, Progress};
 use sampling::{Outputs, Series};
 use step_time::Clock;
@@ -54,10 +56,22 @@ pub fn run(
 /// [`run`], writing checkpoints or continuing from one.
 pub fn run_with(
     scene: &LoadedScene,
+    nodes: Nodes<'_>,
+    info: &RunInfo,
+    plan: &Checkpoints,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Outcome {
+    run_debug(scene, nodes, info, plan, progress, None)
+}
+
+/// [`run_with`], paused and driven by `debugger` between two steps (`cosim run --break`, `cosim ctl`).
+pub fn run_debug(
+    scene: &LoadedScene,
     mut nodes: Nodes<'_>,
     info: &RunInfo,
     plan: &Checkpoints,
     progress: &mut dyn FnMut(Progress) -> Control,
+    debugger: Option<&mut Debugger<'_>>,
 ) -> Outcome {
     let started = Instant::now();
     let (fem_nodes, fem_elements) = nodes
@@ -70,7 +84,17 @@ pub fn run_with(
         .sizes(particles, fem_nodes, fem_elements)
         .running();
     let mut series = Vec::new();
-    let error = drive(scene, &mut nodes, info, plan, progress, &mut summary, &mut series).err();
+    let error = drive(
+        scene,
+        &mut nodes,
+        info,
+        plan,
+        progress,
+        &mut summary,
+        &mut series,
+        debugger,
+    )
+    .err();
     if error.is_some() {
         // What the nodes still alive counted up to the failure (a finished run asked them before its stop).
         collect_counts(&mut nodes, &mut summary);
@@ -95,6 +119,7 @@ pub fn run_with(
 }
 
 /// The run from its first command to its last: the step loop (`DESIGN.md` §3).
+#[allow(clippy::too_many_arguments)]
 fn drive(
     scene: &LoadedScene,
     nodes: &mut Nodes<'_>,
@@ -103,6 +128,7 @@ fn drive(
     progress: &mut dyn FnMut(Progress) -> Control,
     summary: &mut Summary,
     series: &mut Series,
+    mut debugger: Option<&mut Debugger<'_>>,
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
     check_registrations(nodes)?;
@@ -131,35 +157,56 @@ fn drive(
             )?;
         }
     }
-    while clock.running() {
-        // §3 step 1: how long this step is, and whether it lands on an output time.
-        let step = clock.next_step();
-        // §3 steps 2–3: the commands out (with the last pass's corrections), the states in.
-        let commands = contact.commands(step.dt, step.lands);
-        let mut round = exchange::exchange(nodes, &interface_ids, summary, clock.step, clock.t, commands)?;
-        clock.advance(&step, &round, summary);
-        // §3 step 4: contact on the states just reported; the corrections go out with the next command.
-        contact.pass(&round, &step, clock.step, clock.t, summary)?;
-        // §5: probes and frames at an output time.
-        if step.lands {
-            outputs.sample(
-                clock.t,
-                &mut round,
-                nodes,
-                contact.load.as_deref(),
-                &mut contact.since,
+    let mut stepping = || -> anyhow::Result<()> {
+        while clock.running() {
+            // §3 step 1: how long this step is, and whether it lands on an output time.
+            let step = clock.next_step();
+            // §3 steps 2–3: the commands out (with the last pass's corrections), the states in.
+            let commands = contact.commands(step.dt, step.lands);
+            let mut round = exchange::exchange(nodes, &interface_ids, summary, clock.step, clock.t, commands)?;
+            clock.advance(&step, &round, summary);
+            // §3 step 4: contact on the states just reported; the corrections go out with the next command.
+            contact.pass(&round, &step, clock.step, clock.t, summary)?;
+            // §5: probes and frames at an output time.
+            if step.lands {
+                outputs.sample(
+                    clock.t,
+                    &mut round,
+                    nodes,
+                    contact.load.as_deref(),
+                    &mut contact.since,
+                    summary,
+                )?;
+                clock.sampled(&step);
+            }
+            progress::report(progress, &clock, &contact, summary)?;
+            let state = RunState {
+                clock: &clock,
+                contact: &contact,
+                outputs: &outputs,
                 summary,
-            )?;
-            clock.sampled(&step);
+            };
+            checkpointing::save_if_due(&mut checkpoints, &step, state, scene, nodes, info)?;
+            // Between two steps, every node waiting for its next command: where a run pauses (`pause.rs`).
+            if let Some(debugger) = debugger.as_deref_mut() {
+                let max_penetration = summary.contact_stats.max_penetration;
+                let mut halt = Halt::new(clock.step, clock.t, max_penetration, &contact.pending, nodes);
+                debugger.after_step(&mut halt).map_err(|why| {
+                    anyhow::anyhow!("stopped after coupling step {} (t = {} s): {why}", clock.step, clock.t)
+                })?;
+            }
         }
-        progress::report(progress, &clock, &contact, summary)?;
-        let state = RunState {
-            clock: &clock,
-            contact: &contact,
-            outputs: &outputs,
-            summary,
-        };
-        checkpointing::save_if_due(&mut checkpoints, &step, state, scene, nodes, info)?;
+        Ok(())
+    };
+    if let Err(e) = stepping() {
+        // `--break unstable`: a blow-up pauses the run where it happened, every process alive, until it is stopped.
+        let unstable = e.downcast_ref::<LinkError>().map(LinkError::status) == Some(RunStatus::Unstable);
+        if let (true, Some(debugger)) = (unstable, debugger) {
+            let max_penetration = summary.contact_stats.max_penetration;
+            let mut halt = Halt::new(clock.step, clock.t, max_penetration, &contact.pending, nodes);
+            debugger.on_unstable(&mut halt, &format!("{e:#}").replace('\n', " "));
+        }
+        return Err(e);
     }
     collect_counts(nodes, summary);
     exchange::stop(nodes, clock.step + 1, clock.t)?;

@@ -115,7 +115,15 @@ impl FrameWriter {
         fields: &[PointField<'_>],
     ) -> Result<PathBuf> {
         let name = format!("particles_{index:05}.vtu");
-        let path = self.dir.join(&name);
+        let path = self.write_points(&name, x, fields)?;
+        self.particles.push(t, &name)?;
+        Ok(path)
+    }
+
+    /// Write `DIR/frames/{name}` (one `VTK_VERTEX` cell per point at `x`, z = 0, with `fields` as point data),
+    /// listed in no collection (a snapshot's contacts, `cosim snapshot`); returns its path.
+    pub fn write_points(&mut self, name: &str, x: &[Part<'_, [f64; 2]>], fields: &[PointField<'_>]) -> Result<PathBuf> {
+        let path = self.dir.join(name);
         let n = x.iter().map(Part::len).sum();
         for field in fields {
             let len = field.len();
@@ -132,7 +140,6 @@ impl FrameWriter {
             let piece = particle_piece(&concat(x), fields);
             write_vtu(&path, piece)?;
         }
-        self.particles.push(t, &name)?;
         Ok(path)
     }
 }

@@ -1,0 +1,76 @@
+//! Joining a live run from another process, as `cosim inspect`, `cosim ctl` and `cosim snapshot` do: found on this
+//! machine through the run registry (`registry.rs`), or given its endpoint (`--connect`, the broker's or a
+//! router's, `--client` for a router).
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Args;
+use cosim_bus::session::{base_config, open_client_from, open_listening_from};
+use zenoh::Session;
+
+use crate::registry;
+
+/// How to reach a live run.
+#[derive(Args, Debug, Clone)]
+pub struct JoinArgs {
+    /// Endpoint of the run (its broker's, or the router's) for a run on another host; a run on this machine is
+    /// found without it.
+    #[arg(long)]
+    pub connect: Option<String>,
+    /// `--connect` is a zenoh router: join through it as a client.
+    #[arg(long)]
+    pub client: bool,
+    /// A zenoh JSON5 config file the session starts from (as the run's `--zenoh-config`).
+    #[arg(long, value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+    /// Seconds to wait for the run's answers.
+    #[arg(long, default_value_t = 10.0)]
+    pub timeout: f64,
+}
+
+/// Open a session on run `id`'s network; also the endpoint joined. `Err` (exit 2) for a run not found here without
+/// `--connect`, a bad config file, or a run that cannot be reached.
+pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
+    let (connect, client, zenoh_config) = match &how.connect {
+        Some(c) => (c.clone(), how.client, how.zenoh_config.clone()),
+        None => match registry::lookup(id) {
+            Some(e) => (
+                e.connect,
+                e.client || how.client,
+                how.zenoh_config.clone().or(e.zenoh_config),
+            ),
+            None => anyhow::bail!(
+                "run `{id}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
+                 elsewhere (an in-process run cannot be reached from another process)",
+                registry::dir().display()
+            ),
+        },
+    };
+    anyhow::ensure!(
+        how.timeout.is_finite() && how.timeout > 0.0,
+        "--timeout must be a positive number of seconds, got {}",
+        how.timeout
+    );
+    let timeout_ms = (how.timeout * 1000.0) as u64;
+    let base = zenoh_config.as_deref();
+    // A bad config file is its own error, not "cannot reach the run".
+    base_config(base)?;
+    let session = match client {
+        true => open_client_from(base, std::slice::from_ref(&connect), timeout_ms),
+        // Listening too: the nodes learn of this process through the broker (gossip) and connect to it, which is
+        // how their answers reach it (peers do not forward for each other). Zenoh gossips the addresses of a
+        // wildcard listener, not of one bound to 127.0.0.1, hence 0.0.0.0 (for this process's few seconds only).
+        false => open_listening_from(
+            base,
+            &["tcp/0.0.0.0:0".to_string()],
+            std::slice::from_ref(&connect),
+            timeout_ms,
+        )
+        .map(|(s, _)| s),
+    }
+    .map_err(|e| anyhow::anyhow!("cannot reach run `{id}` at {connect}: {e:#}"))?;
+    // Let zenoh learn the run's queryables (gossip) before the first question.
+    std::thread::sleep(Duration::from_millis(1500));
+    Ok((session, connect))
+}

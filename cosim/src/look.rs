@@ -1,0 +1,285 @@
+//! Looking inside a live run (`cosim snapshot`, `cosim inspect RUN --particle ID | --node ID`): its state between
+//! two steps from its broker (`cosim/<run>/broker/state`, `docs/PROTOCOL.md` §11: every node's checkpoint and the
+//! last contact pass's corrections), read here with the nodes' own code, and the scene from the broker's `scene`
+//! queryable. Reading changes nothing in the run: the nodes answer a checkpoint query from their state as it is.
+
+use std::time::Duration;
+
+use anyhow::Context;
+use cosim_proto::control::DebugState;
+use cosim_proto::envelope::Envelope;
+use cosim_proto::keys::{key, topic};
+use cosim_proto::messages::{Correction, FemMesh, FemSnapshot, StepCommand};
+use cosim_proto::scene::Scene;
+use fem_node::core::FemCore;
+use serde_json::json;
+use sph_node::core::SphCheckpoint;
+use zenoh::{Session, Wait};
+
+/// The structure as the run holds it now.
+pub struct FemView {
+    /// Its mesh (reference positions, cells, interface segments, masses).
+    pub mesh: FemMesh,
+    /// Its state now (positions, velocities, stresses, energies).
+    pub snap: FemSnapshot,
+}
+
+/// A live run's state between two steps.
+pub struct Look {
+    /// Last coupling step done.
+    pub step: u64,
+    /// Simulated time [s].
+    pub t: f64,
+    /// `paused at step N: REASON`, or empty while running.
+    pub paused: String,
+    /// The scene as the run runs it.
+    pub scene: Scene,
+    /// The structure, if the scene has one.
+    pub fem: Option<FemView>,
+    /// The fluid (and walls), if the scene has one.
+    pub sph: Option<SphCheckpoint>,
+    /// The broker's part: the last pass's corrections, the deepest penetration so far.
+    pub debug: DebugState,
+}
+
+fn ask(session: &Session, id: &str, what: &str, timeout: Duration) -> anyhow::Result<Vec<u8>> {
+    let replies = session
+        .get(key(id, what))
+        .timeout(timeout)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let reply = replies.recv().map_err(|_| {
+        anyhow::anyhow!(
+            "the broker of run `{id}` did not answer {what} within {:.0} s",
+            timeout.as_secs_f64()
+        )
+    })?;
+    match reply.result() {
+        Ok(sample) => Ok(sample.payload().to_bytes().into_owned()),
+        Err(e) => {
+            let why = e
+                .payload()
+                .try_to_string()
+                .map_or_else(|_| "(no reason)".into(), |s| s.into_owned());
+            anyhow::bail!("the broker of run `{id}` refused {what}: {why}")
+        }
+    }
+}
+
+/// Fetch and read run `id`'s state now (a running run answers between two steps).
+pub fn fetch(session: &Session, id: &str, timeout: Duration) -> anyhow::Result<Look> {
+    let text = String::from_utf8(ask(session, id, topic::SCENE, timeout)?).context("the run's scene")?;
+    let scene = cosim_proto::scene::parse("(scene from the broker)", &text, &[])?;
+    let bytes = ask(session, id, topic::BROKER_STATE, timeout)?;
+    let env = Envelope::<DebugState>::decode(&bytes, id, topic::BROKER_STATE)?;
+    let fem = match env.body.fem.is_empty() {
+        true => None,
+        false => {
+            let mut core = FemCore::new(&scene).context("fem-node")?;
+            core.restore(&env.body.fem)
+                .context("cannot read the structure node's state")?;
+            // A step of length 0 moves nothing and answers the state as it is, on this copy of the node.
+            let look = StepCommand {
+                dt: 0.0,
+                corrections: Vec::new(),
+                roi: None,
+                want_interface: false,
+                want_snapshot: true,
+                stop: false,
+            };
+            let snap = core
+                .handle(&look)
+                .context("cannot read the structure node's state")?
+                .and_then(|s| s.snapshot)
+                .context("the structure node's state gave no snapshot")?;
+            Some(FemView {
+                mesh: core.mesh().clone(),
+                snap,
+            })
+        }
+    };
+    let sph = match env.body.sph.is_empty() {
+        true => None,
+        false => Some(SphCheckpoint::decode(&env.body.sph).context("cannot read the fluid node's state")?),
+    };
+    Ok(Look {
+        step: env.step,
+        t: env.t,
+        paused: env.body.paused.clone(),
+        scene,
+        fem,
+        sph,
+        debug: env.body,
+    })
+}
+
+/// One particle the last contact pass corrected, against the interface segment nearest it now.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ContactRow {
+    /// Fluid particle id.
+    pub particle: u32,
+    /// Its position now (before the correction, which goes out with the next command) [m].
+    pub x: [f64; 2],
+    /// Index of the nearest interface segment (into `fem/mesh` `interface`), and its two nodes.
+    pub segment: usize,
+    /// Its nodes a, b.
+    pub nodes: [u32; 2],
+    /// Gap g = (x_s − x_c)·n − r_c to it now [m] (DESIGN.md §4.5; negative: penetrating).
+    pub gap: f64,
+    /// λ = m_s Δx·n: the position impulse the pass gave the particle along the segment's normal, all sweeps [kg m].
+    pub lambda: f64,
+    /// J = m_s Δv·n: the velocity impulse along the normal, all sweeps [kg m/s].
+    pub impulse: f64,
+    /// The correction itself.
+    pub dx: [f64; 2],
+    /// Its velocity part.
+    pub dv: [f64; 2],
+}
+
+/// The contacts of the last pass: every particle it corrected, with the segment nearest it, its gap, λ and J
+/// (DESIGN.md §4.5, recovered from the correction: λ = m Δx·n, J = m Δv·n).
+pub fn contacts(look: &Look) -> Vec<ContactRow> {
+    let (Some(fem), Some(sph)) = (&look.fem, &look.sph) else {
+        return Vec::new();
+    };
+    let state = &sph.solver.state;
+    let spacing = look.scene.fluid.as_ref().map_or(0.0, |f| f.spacing);
+    let r_c = look.scene.contact.thickness.unwrap_or(0.5 * spacing);
+    let mut rows = Vec::new();
+    for c in &look.debug.sph_corrections {
+        let i = c.id as usize;
+        let (Some(&x), Some(&m)) = (state.x.get(i), state.m.get(i)) else {
+            continue;
+        };
+        let Some((segment, nodes, x_c, n)) = nearest_segment(&fem.mesh, &fem.snap.x, x) else {
+            continue;
+        };
+        let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
+        rows.push(ContactRow {
+            particle: c.id,
+            x,
+            segment,
+            nodes,
+            gap: dot([x[0] - x_c[0], x[1] - x_c[1]], n) - r_c,
+            lambda: m * dot(c.dx, n),
+            impulse: m * dot(c.dv, n),
+            dx: c.dx,
+            dv: c.dv,
+        });
+    }
+    rows
+}
+
+/// An interface segment as a point sees it: its index, its nodes, the point's closest point on it and its outward
+/// unit normal.
+type Nearest = (usize, [u32; 2], [f64; 2], [f64; 2]);
+
+/// The interface segment nearest `p` (positions `x` of the mesh's nodes): its index, nodes, the closest point on
+/// it and its outward unit normal (dy, −dx)/L (`fem/mesh` runs boundaries counter-clockwise).
+fn nearest_segment(mesh: &FemMesh, x: &[[f64; 2]], p: [f64; 2]) -> Option<Nearest> {
+    let mut best: Option<(f64, Nearest)> = None;
+    for (k, s) in mesh.interface.iter().enumerate() {
+        let (Some(&a), Some(&b)) = (x.get(s.a as usize), x.get(s.b as usize)) else {
+            continue;
+        };
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = d[0].hypot(d[1]);
+        if len == 0.0 {
+            continue;
+        }
+        let xi = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / (len * len)).clamp(0.0, 1.0);
+        let c = [a[0] + xi * d[0], a[1] + xi * d[1]];
+        let dist = (p[0] - c[0]).hypot(p[1] - c[1]);
+        if best.as_ref().is_none_or(|(bd, _)| dist < *bd) {
+            best = Some((dist, (k, [s.a, s.b], c, [d[1] / len, -d[0] / len])));
+        }
+    }
+    best.map(|(_, found)| found)
+}
+
+fn correction_of(list: &[Correction], id: u32) -> serde_json::Value {
+    list.iter()
+        .find(|c| c.id == id)
+        .map_or(serde_json::Value::Null, |c| json!({"dx": c.dx, "dv": c.dv}))
+}
+
+fn head(look: &Look) -> serde_json::Value {
+    json!({"step": look.step, "t": look.t, "paused": look.paused})
+}
+
+/// One fluid particle: its state, its neighbours within the kernel's support 2h (fluid ids nearest first, and how
+/// many wall particles), the last pass's correction and contact.
+pub fn particle(look: &Look, id: u32) -> anyhow::Result<serde_json::Value> {
+    let sph = look.sph.as_ref().context("the run has no fluid")?;
+    let s = &sph.solver.state;
+    let i = id as usize;
+    anyhow::ensure!(
+        i < s.x.len(),
+        "--particle {id}: the fluid has particles 0 to {}",
+        s.x.len().saturating_sub(1)
+    );
+    let (field, at) = (|v: &[f64]| v.get(i).copied().unwrap_or(f64::NAN), s.x[i]);
+    let support = 2.0 * look.scene.fluid.as_ref().map_or(0.0, |f| f.smoothing_ratio * f.spacing);
+    let within = |p: &[f64; 2]| {
+        let r = (p[0] - at[0]).hypot(p[1] - at[1]);
+        (r < support).then_some(r)
+    };
+    let mut fluid: Vec<(f64, usize)> =
+        s.x.iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i)
+            .filter_map(|(j, p)| within(p).map(|r| (r, j)))
+            .collect();
+    fluid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let walls = sph.solver.walls.x.iter().filter(|p| within(p).is_some()).count();
+    let contact = contacts(look).into_iter().find(|c| c.particle == id);
+    let mut doc = head(look);
+    doc["particle"] = json!({
+        "id": id,
+        "x": at,
+        "v": s.v.get(i),
+        "rho": field(&s.rho),
+        "p": field(&s.p),
+        "m": field(&s.m),
+        "neighbours": {"support": support, "fluid": fluid.iter().map(|n| n.1).collect::<Vec<_>>(), "walls": walls},
+        "correction": correction_of(&look.debug.sph_corrections, id),
+        "contact": contact,
+    });
+    Ok(doc)
+}
+
+/// One FE node: its state, reference position and displacement, the interface segments it ends, whether it is
+/// clamped, and the last pass's correction.
+pub fn node(look: &Look, id: u32) -> anyhow::Result<serde_json::Value> {
+    let fem = look.fem.as_ref().context("the run has no structure")?;
+    let i = id as usize;
+    let n = fem.mesh.nodes.len();
+    anyhow::ensure!(
+        i < n && i < fem.snap.x.len(),
+        "--node {id}: the structure has nodes 0 to {}",
+        n.saturating_sub(1)
+    );
+    let (x, x0) = (fem.snap.x[i], fem.mesh.nodes[i]);
+    let segments: Vec<serde_json::Value> = fem
+        .mesh
+        .interface
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.a == id || s.b == id)
+        .map(|(k, s)| json!({"segment": k, "nodes": [s.a, s.b]}))
+        .collect();
+    let mut doc = head(look);
+    doc["node"] = json!({
+        "id": id,
+        "x": x,
+        "v": fem.snap.v.get(i),
+        "reference": x0,
+        "displacement": [x[0] - x0[0], x[1] - x0[1]],
+        "mass": fem.mesh.masses.get(i),
+        "solid": fem.mesh.node_solid.get(i).and_then(|&s| fem.mesh.solid_names.get(s as usize)),
+        "fixed": fem.mesh.fixed.contains(&id),
+        "segments": segments,
+        "correction": correction_of(&look.debug.fem_corrections, id),
+    });
+    Ok(doc)
+}
