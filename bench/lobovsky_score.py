@@ -8,6 +8,9 @@ with the criteria of issue 16 and cosim/tests/lobovsky.rs, on the data's own tim
   min           the lowest p* (bound: >= -0.5)
   zeros         samples of exactly 0 from 0.1 t* after the first impact on (the sensors stay under water; bound: none)
 
+and, where the run has them (`level_H1` ... `level_H4`), the water-level gauges against the recorded levels:
+  the RMS of (level_sim - level_data)/H over the run's samples in the data's time range, and the mean difference.
+
 t* = t sqrt(g/H), p* = p/(rho g H). Usage: python3 bench/lobovsky_score.py OUT_DIR [OUT_DIR ...]
 (OUT_DIR holds probes.csv with p_sensor1, p_sensor2 and, if present, p_sensor1_raw, p_sensor2_raw).
 Exit status 0 whatever the scores: this reports, it does not judge.
@@ -24,9 +27,12 @@ DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", 
 
 
 def data(sensor):
-    path = os.path.join(DATA, f"lobovsky2014_H300_sensor{sensor}_event.csv")
-    with open(path) as f:
-        return [(float(r["t_star"]), float(r["p_star"])) for r in csv.DictReader(f)]
+    return series(f"lobovsky2014_H300_sensor{sensor}_event.csv", "p_star")
+
+
+def series(name, column):
+    with open(os.path.join(DATA, name)) as f:
+        return [(float(r["t_star"]), float(r[column])) for r in csv.DictReader(f)]
 
 
 def at(s, t):
@@ -68,6 +74,18 @@ def main():
                 sim = [(float(r["t"]) / T_SCALE, float(r[name]) / P_SCALE) for r in rows]
                 t1, t1d, peak, peakd, rms, low, zeros = score(sim, ref)
                 print(f"{out} | {name} | {t1:.3f} ({t1d:.3f}) | {peak:.2f} ({peakd:.2f}) | {rms:.3f} | {low:.2f} | {zeros}")
+        for gauge in (1, 2, 3, 4):
+            name = f"level_H{gauge}"
+            if not rows or name not in rows[0]:
+                continue
+            ref = series(f"lobovsky2014_H300_level_H{gauge}.csv", "level")
+            diffs = [
+                float(r[name]) / H - at(ref, float(r["t"]) / T_SCALE)
+                for r in rows
+                if ref[0][0] <= float(r["t"]) / T_SCALE <= ref[-1][0]
+            ]
+            rms = math.sqrt(sum(d * d for d in diffs) / len(diffs))
+            print(f"{out} | {name} | level/H: RMS difference {rms:.3f}, mean {sum(diffs) / len(diffs):+.3f} ({len(diffs)} samples)")
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@
 use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
 use cosim_proto::scene::{Average, EnergyOf, EnergyPart, PressureSensor, ProbeKind, Scene};
 use serde::{Deserialize, Serialize};
+use sph_node::gauge::water_level;
 use sph_node::sensors::{sensor_pressure, PressureField};
 
 /// A probe resolved against the registered mesh and particles.
@@ -20,6 +21,8 @@ enum Resolved {
     Front { component: usize },
     /// Highest fluid particle with x ≤ x_max.
     Column { x_max: f64 },
+    /// Height of the water surface above a gauge's foot.
+    Level { foot: [f64; 2] },
     /// Shepard-normalised SPH pressure, the mean over a sensor's face, now.
     Pressure { sensor: PressureSensor },
     /// The same, its time mean over the sampling interval: the fluid node's interval sensor `index`.
@@ -140,6 +143,12 @@ impl Probes {
                         x_max: spec.x_max.ok_or_else(|| missing("x_max"))?,
                     }
                 }
+                ProbeKind::WaterLevel => {
+                    need_fluid(p)?;
+                    Resolved::Level {
+                        foot: spec.point.ok_or_else(|| missing("point"))?,
+                    }
+                }
                 ProbeKind::Pressure => {
                     let setup = fluid.ok_or_else(|| format!("probe[{p}].kind: the run has no fluid node"))?;
                     let sensor = PressureSensor::of(scene, p, setup.spacing).ok_or_else(|| missing("point"))?;
@@ -208,18 +217,11 @@ impl Probes {
                         .reduce(f64::max)
                         .unwrap_or(f64::NAN)
                 }),
+                Resolved::Level { foot } => sph.map_or(f64::NAN, |(setup, s)| {
+                    water_level(&field(setup, s), foot)
+                }),
                 Resolved::Pressure { ref sensor } => sph.map_or(f64::NAN, |(setup, s)| {
-                    let field = PressureField {
-                        x: &s.x,
-                        m: &s.m,
-                        rho: &s.rho,
-                        p: &s.p,
-                        wall_x: &setup.walls,
-                        wall_p: &s.wall_p,
-                        h: setup.h,
-                        spacing: setup.spacing,
-                    };
-                    sensor_pressure(&field, sensor)
+                    sensor_pressure(&field(setup, s), sensor)
                 }),
                 Resolved::PressureMean { index } => {
                     sph.map_or(f64::NAN, |(_, s)| s.sensors.get(index).copied().unwrap_or(f64::NAN))
@@ -283,6 +285,20 @@ fn nearest_node(mesh: &FemMesh, solid: usize, point: [f64; 2]) -> Option<usize> 
         .map(|(n, _)| n)
 }
 
+/// The fluid and wall particles of a snapshot, as the pressure and level probes read them.
+fn field<'a>(setup: &'a SphSetup, s: &'a SphSnapshot) -> PressureField<'a> {
+    PressureField {
+        x: &s.x,
+        m: &s.m,
+        rho: &s.rho,
+        p: &s.p,
+        wall_x: &setup.walls,
+        wall_p: &s.wall_p,
+        h: setup.h,
+        spacing: setup.spacing,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -331,3 +347,4 @@ mod tests {
         assert!(empty[column].is_nan(), "{}", empty[column]);
     }
 }
+

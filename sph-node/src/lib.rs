@@ -26,6 +26,7 @@ pub mod corrections;
 pub mod eos;
 pub mod error;
 pub mod fluid_solver;
+pub mod gauge;
 pub mod integrator;
 pub mod isph;
 pub mod kernel;

@@ -294,7 +294,7 @@ impl Scene {
                         || "missing key (interface_load)".into(),
                     )?;
                 }
-                ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure => {
+                ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure | ProbeKind::WaterLevel => {
                     check(
                         self.fluid.is_some(),
                         || key("kind"),

@@ -15,6 +15,9 @@ pub enum ProbeKind {
     SurgeFront,
     /// Highest fluid particle among those with x ≤ `x_max` (the residual column of a dam break).
     ColumnHeight,
+    /// Height of the water surface above `point` (the gauge's foot) along the vertical line through it: where the
+    /// SPH fluid fraction passes ½, the highest such surface (a gauge looking down; 0 where the line is dry).
+    WaterLevel,
     /// SPH-interpolated pressure at `point`; optionally the mean over a sensor face (`radius`, `normal`) and over
     /// the sampling interval (`average = "interval"`).
     Pressure,
