@@ -20,6 +20,7 @@
 //! ([`BrokerState::check`]). Pure: files only, no messaging.
 
 mod broker_state;
+pub mod restore_reply;
 
 use std::collections::BTreeMap;
 use std::io::Write;

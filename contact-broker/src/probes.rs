@@ -217,12 +217,10 @@ impl Probes {
                         .reduce(f64::max)
                         .unwrap_or(f64::NAN)
                 }),
-                Resolved::Level { foot } => sph.map_or(f64::NAN, |(setup, s)| {
-                    water_level(&field(setup, s), foot)
-                }),
-                Resolved::Pressure { ref sensor } => sph.map_or(f64::NAN, |(setup, s)| {
-                    sensor_pressure(&field(setup, s), sensor)
-                }),
+                Resolved::Level { foot } => sph.map_or(f64::NAN, |(setup, s)| water_level(&field(setup, s), foot)),
+                Resolved::Pressure { ref sensor } => {
+                    sph.map_or(f64::NAN, |(setup, s)| sensor_pressure(&field(setup, s), sensor))
+                }
                 Resolved::PressureMean { index } => {
                     sph.map_or(f64::NAN, |(_, s)| s.sensors.get(index).copied().unwrap_or(f64::NAN))
                 }
@@ -347,4 +345,3 @@ mod tests {
         assert!(empty[column].is_nan(), "{}", empty[column]);
     }
 }
-

@@ -47,7 +47,7 @@ pub fn serve_restore(
     topics: NodeTopics,
     saved: Option<(u64, f64, Vec<u8>)>,
 ) -> anyhow::Result<Queryable<()>> {
-    let bytes = restore_reply(run, topics, saved)?;
+    let bytes = crate::checkpoint::restore_reply::restore_reply(run, topics, saved)?;
     session
         .declare_queryable(key(run, topics.restore))
         .callback(move |query| {
@@ -57,16 +57,6 @@ pub fn serve_restore(
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("{e}"))
-}
-
-/// The reply [`serve_restore`] gives, encoded (`saved` as there).
-pub fn restore_reply(run: &str, topics: NodeTopics, saved: Option<(u64, f64, Vec<u8>)>) -> anyhow::Result<Vec<u8>> {
-    let (step, t, data) = saved.unwrap_or((0, 0.0, Vec::new()));
-    let body = NodeCheckpoint {
-        node: topics.name.into(),
-        data,
-    };
-    Ok(Envelope::new(run, step, t, body).encode_checked(topics.restore)?)
 }
 
 type Sub = Subscriber<FifoChannelHandler<Sample>>;

@@ -96,7 +96,10 @@ mod tests {
         };
         for xg in [0.1, 0.2543, 0.4] {
             let level = water_level(&field, [xg, 0.0]);
-            assert!((level - depth).abs() < 0.05 * dx, "x = {xg}: level {level}, depth {depth}");
+            assert!(
+                (level - depth).abs() < 0.05 * dx,
+                "x = {xg}: level {level}, depth {depth}"
+            );
         }
         // Beyond the water's end (x = 0.5 m) by more than the kernel's reach: the floor alone.
         let dry = water_level(&field, [0.8, 0.0]);

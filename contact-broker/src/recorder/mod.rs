@@ -116,7 +116,7 @@ impl Recorder {
             ),
         ];
         for (_, topics, node, saved) in nodes.into_iter().filter(|n| n.0) {
-            let reply = crate::transport::restore_reply(run, topics, saved)?;
+            let reply = crate::checkpoint::restore_reply::restore_reply(run, topics, saved)?;
             r.record(Kind::Restore, node, 0, &reply);
         }
         Ok(r)

@@ -141,7 +141,7 @@ impl Player {
             Some(bytes) => RawEnvelope::split(bytes)
                 .ok_or_else(|| anyhow::anyhow!("{}: the restore record is not an envelope", script.path.display()))?
                 .for_run(run),
-            None => contact_broker::transport::restore_reply(run, topics, None)?,
+            None => contact_broker::checkpoint::restore_reply::restore_reply(run, topics, None)?,
         };
         let restore = session
             .declare_queryable(key(run, topics.restore))
