@@ -14,6 +14,7 @@
 //! [`ParticleElement`] is the [`ContactAlgorithm`] that runs it with its own [`ParticleElementWorkspace`].
 
 mod detection;
+mod pairs;
 mod params;
 mod position;
 mod projection;
@@ -27,6 +28,7 @@ mod workspace;
 #[cfg(test)]
 mod tests;
 
+pub use pairs::{ContactPair, PairMaster};
 pub use params::ContactParams;
 pub use report::ContactReport;
 pub use workspace::ParticleElementWorkspace;
@@ -69,6 +71,7 @@ pub fn particle_element_with(
         ..ContactReport::default()
     };
     if particles.x.is_empty() || segments.is_empty() {
+        ws.pairs.clear();
         return Ok(report);
     }
     let ParticleElementWorkspace {
@@ -81,14 +84,35 @@ pub fn particle_element_with(
         contacts,
         planes,
         exhaustive,
+        pairs,
     } = ws;
+    pairs.clear();
     marks.clear();
     marks.resize(particles.x.len(), Mark::default());
 
     let setup = Setup::new(grid, topo, inv_m, &nodes, segments, params, *exhaustive);
-    position::phase(&setup, &mut particles, &mut nodes, masters, rigid, marks, &mut report);
+    position::phase(
+        &setup,
+        &mut particles,
+        &mut nodes,
+        masters,
+        rigid,
+        marks,
+        pairs,
+        &mut report,
+    );
     touching::collect(&setup, particles.x, nodes.x, marks, masters, contacts, &mut report);
-    velocity::phase(&setup, &mut particles, &mut nodes, contacts, planes, marks, &mut report);
+    velocity::phase(
+        &setup,
+        &mut particles,
+        &mut nodes,
+        contacts,
+        planes,
+        marks,
+        pairs,
+        &mut report,
+    );
+    pairs.finish();
 
     report.particles_corrected = marks.iter().filter(|m| m.corrected).count();
     Ok(report)
@@ -109,6 +133,11 @@ impl ParticleElement {
             params,
             workspace: ParticleElementWorkspace::default(),
         }
+    }
+
+    /// The pairs the last pass acted on ([`ParticleElementWorkspace::pairs`]).
+    pub fn pairs(&self) -> &[ContactPair] {
+        self.workspace.pairs()
     }
 }
 
