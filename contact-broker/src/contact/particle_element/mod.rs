@@ -157,4 +157,8 @@ impl ContactAlgorithm for ParticleElement {
             node_impulse: report.node_impulse,
         })
     }
+
+    fn pairs(&self) -> Option<&[ContactPair]> {
+        Some(self.workspace.pairs())
+    }
 }
