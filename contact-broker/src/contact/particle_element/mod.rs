@@ -36,6 +36,7 @@ pub use workspace::ParticleElementWorkspace;
 use crate::contact::algorithm::{ContactAlgorithm, PassReport};
 use crate::contact::bodies::{validate, Nodes, Particles, Segment};
 use crate::contact::error::ContactError;
+use pairs::Out;
 use setup::{Mark, Setup};
 
 /// Corrects particles and nodes in place (see the [module docs](super) for the algorithm) with a fresh workspace.
@@ -98,8 +99,10 @@ pub fn particle_element_with(
         masters,
         rigid,
         marks,
-        pairs,
-        &mut report,
+        Out {
+            report: &mut report,
+            pairs,
+        },
     );
     touching::collect(&setup, particles.x, nodes.x, marks, masters, contacts, &mut report);
     velocity::phase(
@@ -109,8 +112,10 @@ pub fn particle_element_with(
         contacts,
         planes,
         marks,
-        pairs,
-        &mut report,
+        Out {
+            report: &mut report,
+            pairs,
+        },
     );
     pairs.finish();
 

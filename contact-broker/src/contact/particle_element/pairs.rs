@@ -43,6 +43,12 @@ pub struct ContactPair {
     pub impulse: f64,
 }
 
+/// Where a phase writes what it did: the pass's report and its pair log.
+pub(super) struct Out<'a> {
+    pub report: &'a mut super::report::ContactReport,
+    pub pairs: &'a mut PairLog,
+}
+
 /// The pairs of one pass: raw entries (each with its order) while it runs, one per pair once
 /// [`PairLog::finish`] merged them.
 #[derive(Clone, Debug, Default)]

@@ -4,7 +4,7 @@
 //! (`projection.rs`).
 
 use super::detection::{Hit, Master};
-use super::pairs::PairLog;
+use super::pairs::Out;
 use super::projection;
 use super::report::ContactReport;
 use super::setup::{Mark, Setup};
@@ -26,9 +26,9 @@ pub(super) fn phase(
     masters: &mut Vec<Master>,
     rigid: &mut Vec<Master>,
     marks: &mut [Mark],
-    pairs: &mut PairLog,
-    report: &mut ContactReport,
+    out: Out,
 ) {
+    let Out { report, pairs } = out;
     let pos_fixed = &*setup.pos_fixed;
     for sweep in 0..setup.params.sweeps {
         let first = sweep == 0;
@@ -67,7 +67,18 @@ pub(super) fn phase(
                 mark.corrected = true;
             }
             // Immovable masters: the exact limit of the sweeps, per particle.
-            let projected = projection::position(setup, particles, s, nodes.x, rigid, first, pairs, report);
+            let projected = projection::position(
+                setup,
+                particles,
+                s,
+                nodes.x,
+                rigid,
+                first,
+                Out {
+                    report: &mut *report,
+                    pairs: &mut *pairs,
+                },
+            );
             worst = worst.max(projected.worst);
             if projected.near {
                 mark.clear = false;

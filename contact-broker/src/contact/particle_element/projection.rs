@@ -4,7 +4,7 @@
 //! inside the contact thickness and no contact approaching, whatever the corner angles.
 
 use super::detection::{Detector, Hit, Master};
-use super::pairs::PairLog;
+use super::pairs::{Out, PairLog};
 use super::report::ContactReport;
 use super::rigid::{position_step, velocity_step, HalfPlane};
 use super::setup::Setup;
@@ -38,9 +38,9 @@ pub(super) fn position(
     node_x: &[Vec2],
     rigid: &[Master],
     first: bool,
-    pairs: &mut PairLog,
-    report: &mut ContactReport,
+    out: Out,
 ) -> Projected {
+    let Out { report, pairs } = out;
     let mut out = Projected::default();
     for step in 0..RIGID_STEPS {
         if rigid.is_empty() {

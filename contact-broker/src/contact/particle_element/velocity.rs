@@ -3,7 +3,7 @@
 //! limit of the sweeps instead (`projection.rs`). Tangential velocity is untouched (free slip).
 
 use super::detection::Hit;
-use super::pairs::PairLog;
+use super::pairs::Out;
 use super::projection::{self, Planes};
 use super::report::ContactReport;
 use super::setup::{Mark, Setup};
@@ -21,9 +21,9 @@ pub(super) fn phase(
     contacts: &[Contact],
     planes: &mut Planes,
     marks: &mut [Mark],
-    pairs: &mut PairLog,
-    report: &mut ContactReport,
+    out: Out,
 ) {
+    let Out { report, pairs } = out;
     let mut v_scale = 0.0;
     for sweep in 0..if contacts.is_empty() { 0 } else { setup.params.sweeps } {
         let mut worst = 0.0f64;
