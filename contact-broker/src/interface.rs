@@ -2,6 +2,7 @@
 //! reports particles from, and the contact pass that turns one step's interface states into the sparse
 //! corrections both nodes apply before the next step. Pure: wire messages in, wire messages out.
 
+use cosim_proto::control::ContactRecord;
 use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState};
 use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
@@ -46,6 +47,10 @@ pub struct Interface {
     /// Contact impulse of the last pass per FE node [N·s/m], for the interface load.
     impulse: Vec<[f64; 2]>,
     dt: f64,
+    /// The pairs the last pass acted on, in fluid and FE ids (reused from pass to pass); `recorded` false where
+    /// the algorithm records none.
+    records: Vec<ContactRecord>,
+    recorded: bool,
 }
 
 impl Interface {
@@ -108,12 +113,20 @@ impl Interface {
             margin: 2.0 * sph.h + thickness.max(dx) + dx,
             impulse: vec![[0.0; 2]; mesh.nodes.len()],
             dt: 0.0,
+            records: Vec::new(),
+            recorded: false,
         })
     }
 
     /// The FE ids of the interface nodes, in the order the structure node reports them.
     pub fn node_ids(&self) -> &[u32] {
         &self.node_ids
+    }
+
+    /// The (particle, master) pairs the last pass acted on, as the algorithm recorded them (gap, λ, J), in fluid
+    /// particle ids, interface segment indices and FE node ids; `None` where the algorithm records none.
+    pub fn contacts(&self) -> Option<&[ContactRecord]> {
+        self.recorded.then_some(&self.records[..])
     }
 
     /// Whether contact is computed at all (`[contact] algorithm` not `none`).
@@ -175,6 +188,8 @@ impl Interface {
             exchanged: sph.ids.len(),
             ..PassStats::default()
         };
+        self.records.clear();
+        self.recorded = self.algorithm.pairs().is_some();
         if !self.active() || sph.ids.is_empty() {
             return Ok((Corrections::default(), stats));
         }
@@ -197,6 +212,25 @@ impl Interface {
             stats.max_penetration = report.max_penetration;
             report.node_impulse
         };
+        if let Some(pairs) = self.algorithm.pairs() {
+            for p in pairs {
+                let Some(&particle) = sph.ids.get(p.particle) else {
+                    continue;
+                };
+                let (segment, node) = match p.master {
+                    contact::PairMaster::Segment(k) => (Some(k), None),
+                    contact::PairMaster::Node(k) => (None, self.node_ids.get(k as usize).copied()),
+                };
+                self.records.push(ContactRecord {
+                    particle,
+                    segment,
+                    node,
+                    gap: p.gap,
+                    lambda: p.lambda,
+                    impulse: p.impulse,
+                });
+            }
+        }
         tracing::debug!(
             contacts = stats.contacts,
             penetration = stats.max_penetration,

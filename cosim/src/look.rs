@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use anyhow::Context;
-use cosim_proto::control::DebugState;
+use cosim_proto::control::{ContactRecord, DebugState};
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic};
 use cosim_proto::messages::{Correction, FemMesh, FemSnapshot, StepCommand};
@@ -113,35 +113,78 @@ pub fn fetch(session: &Session, id: &str, timeout: Duration) -> anyhow::Result<L
     })
 }
 
-/// One particle the last contact pass corrected, against the interface segment nearest it now.
+/// One contact of the last pass: a (particle, master) pair the particle–element pass recorded (`recorded`), or,
+/// for an algorithm that records none (`particle_particle`), a particle it corrected against the interface segment
+/// nearest it now, λ and J reconstructed from the correction (`reconstructed`).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ContactRow {
+    /// `recorded` (by the pass) or `reconstructed` (after it, from the correction).
+    pub source: &'static str,
     /// Fluid particle id.
     pub particle: u32,
     /// Its position now (before the correction, which goes out with the next command) [m].
     pub x: [f64; 2],
-    /// Index of the nearest interface segment (into `fem/mesh` `interface`), and its two nodes.
-    pub segment: usize,
-    /// Its nodes a, b.
+    /// The interface segment (index into `fem/mesh` `interface`; reconstructed: the nearest), −1 for a node
+    /// contact.
+    pub segment: i64,
+    /// Its nodes a, b (a node contact: the node twice).
     pub nodes: [u32; 2],
-    /// Gap g = (x_s − x_c)·n − r_c to it now [m] (DESIGN.md §4.5; negative: penetrating).
+    /// Recorded: the gap when the pass first acted on the pair; reconstructed: g = (x_s − x_c)·n − r_c to the
+    /// nearest segment now [m] (DESIGN.md §4.5; negative: penetrating).
     pub gap: f64,
-    /// λ = m_s Δx·n: the position impulse the pass gave the particle along the segment's normal, all sweeps [kg m].
+    /// The position multiplier λ applied to the pair, all sweeps [kg m] (reconstructed: m_s Δx·n).
     pub lambda: f64,
-    /// J = m_s Δv·n: the velocity impulse along the normal, all sweeps [kg m/s].
+    /// The velocity impulse J applied to the pair, all sweeps [kg m/s] (reconstructed: m_s Δv·n).
     pub impulse: f64,
-    /// The correction itself.
+    /// The particle's whole correction (all its pairs).
     pub dx: [f64; 2],
     /// Its velocity part.
     pub dv: [f64; 2],
 }
 
-/// The contacts of the last pass: every particle it corrected, with the segment nearest it, its gap, λ and J
-/// (DESIGN.md §4.5, recovered from the correction: λ = m Δx·n, J = m Δv·n).
+/// The contacts the last pass recorded (`DebugState::contacts`), with the particle's position and correction.
+fn recorded(look: &Look, fem: &FemView, sph: &SphCheckpoint, records: &[ContactRecord]) -> Vec<ContactRow> {
+    let state = &sph.solver.state;
+    let mut rows = Vec::with_capacity(records.len());
+    for r in records {
+        let Some(&x) = state.x.get(r.particle as usize) else {
+            continue;
+        };
+        let (segment, nodes) = match (r.segment, r.node) {
+            (Some(k), _) => match fem.mesh.interface.get(k as usize) {
+                Some(s) => (i64::from(k), [s.a, s.b]),
+                None => continue,
+            },
+            (None, Some(n)) => (-1, [n, n]),
+            (None, None) => continue,
+        };
+        let c = look.debug.sph_corrections.iter().find(|c| c.id == r.particle);
+        rows.push(ContactRow {
+            source: "recorded",
+            particle: r.particle,
+            x,
+            segment,
+            nodes,
+            gap: r.gap,
+            lambda: r.lambda,
+            impulse: r.impulse,
+            dx: c.map_or([0.0; 2], |c| c.dx),
+            dv: c.map_or([0.0; 2], |c| c.dv),
+        });
+    }
+    rows
+}
+
+/// The contacts of the last pass: the pairs the pass recorded (particle–element), else (`particle_particle`, or
+/// no pass since a restart) every particle it corrected, with the segment nearest it, its gap, λ and J
+/// reconstructed from the correction (DESIGN.md §4.5: λ = m Δx·n, J = m Δv·n).
 pub fn contacts(look: &Look) -> Vec<ContactRow> {
     let (Some(fem), Some(sph)) = (&look.fem, &look.sph) else {
         return Vec::new();
     };
+    if let Some(records) = &look.debug.contacts {
+        return recorded(look, fem, sph, records);
+    }
     let state = &sph.solver.state;
     let spacing = look.scene.fluid.as_ref().map_or(0.0, |f| f.spacing);
     let r_c = look.scene.contact.thickness.unwrap_or(0.5 * spacing);
@@ -156,9 +199,10 @@ pub fn contacts(look: &Look) -> Vec<ContactRow> {
         };
         let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
         rows.push(ContactRow {
+            source: "reconstructed",
             particle: c.id,
             x,
-            segment,
+            segment: segment as i64,
             nodes,
             gap: dot([x[0] - x_c[0], x[1] - x_c[1]], n) - r_c,
             lambda: m * dot(c.dx, n),

@@ -1,9 +1,11 @@
 //! `cosim snapshot RUN --out DIR`: the current state of a live run (paused or running; a running run answers
 //! between two steps) as ParaView frames in `DIR/frames/`, written with the run's own frame writers:
 //! `structure_00000.vtu` (the mesh as the run's structure frames), `particles_00000.vtu` (fluid and wall
-//! particles, as the run's particle frames), each with its `.pvd`, and `contacts.vtu`: one point per particle the
-//! last contact pass corrected, at the particle, with `particle`, `segment`, `gap`, `lambda`, `impulse`,
-//! `dx`, `dv` (`look::contacts`). `DIR/snapshot.json` says which step and time, why the run is paused, and lists
+//! particles, as the run's particle frames), each with its `.pvd`, and `contacts.vtu`: one point per contact of
+//! the last contact pass, at the particle, with `particle`, `segment` (−1 for a node contact), `node`, `gap`,
+//! `lambda`, `impulse`, `dx`, `dv`, `recorded` (`look::contacts`): the (particle, master) pairs the particle–element
+//! pass recorded (`recorded` = 1: gap at detection, λ and J it applied), or for `particle_particle`, which records
+//! none, each corrected particle against its nearest segment with λ, J reconstructed from the correction (0). `DIR/snapshot.json` says which step and time, why the run is paused, and lists
 //! the contacts.
 
 use std::process::ExitCode;
@@ -69,6 +71,8 @@ pub fn write(look: &Look, out: &std::path::Path) -> anyhow::Result<usize> {
     let x: Vec<[f64; 2]> = rows.iter().map(|r| r.x).collect();
     let (dx, dv): (Vec<[f64; 2]>, Vec<[f64; 2]>) = rows.iter().map(|r| (r.dx, r.dv)).unzip();
     let (particle, segment) = (column(&|r| f64::from(r.particle)), column(&|r| r.segment as f64));
+    let node = column(&|r| if r.segment < 0 { f64::from(r.nodes[0]) } else { -1.0 });
+    let recorded = column(&|r| if r.source == "recorded" { 1.0 } else { 0.0 });
     let (gap, lambda, impulse) = (column(&|r| r.gap), column(&|r| r.lambda), column(&|r| r.impulse));
     frames.write_points(
         "contacts.vtu",
@@ -76,11 +80,13 @@ pub fn write(look: &Look, out: &std::path::Path) -> anyhow::Result<usize> {
         &[
             PointField::Scalar("particle", &particle),
             PointField::Scalar("segment", &segment),
+            PointField::Scalar("node", &node),
             PointField::Scalar("gap", &gap),
             PointField::Scalar("lambda", &lambda),
             PointField::Scalar("impulse", &impulse),
             PointField::Vector("dx", &dx),
             PointField::Vector("dv", &dv),
+            PointField::Scalar("recorded", &recorded),
         ],
     )?;
     let doc = serde_json::json!({
@@ -90,6 +96,7 @@ pub fn write(look: &Look, out: &std::path::Path) -> anyhow::Result<usize> {
         "max_penetration": look.debug.max_penetration,
         "particles": look.sph.as_ref().map_or(0, |s| s.solver.state.x.len()),
         "fem_nodes": look.fem.as_ref().map_or(0, |f| f.mesh.nodes.len()),
+        "contacts_source": if look.debug.contacts.is_some() { "recorded" } else { "reconstructed" },
         "contacts": rows,
     });
     let path = out.join("snapshot.json");

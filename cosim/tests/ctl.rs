@@ -164,6 +164,39 @@ fn break_snapshot_step_and_resume_leave_the_run_bit_identical() {
     assert_eq!(s["step"], step);
     assert_eq!(s["particles"], 875);
     assert_eq!(s["fem_nodes"], 480);
+    // The contacts as the particle–element pass recorded them (not reconstructed): each pair with a segment (or a
+    // node), its gap at detection (penetrating or within touch), λ = −g/w ≥ 0 and J = −v_rel/w ≥ 0 (DESIGN.md §4.5).
+    assert_eq!(s["contacts_source"], "recorded", "{s:#}");
+    let contacts = s["contacts"].as_array().unwrap();
+    assert!(!contacts.is_empty(), "the gate touches the fluid by t = {BREAK_AT} s");
+    for c in contacts {
+        assert_eq!(c["source"], "recorded", "{c}");
+        let segment = c["segment"].as_i64().unwrap();
+        assert!(segment >= -1, "{c}");
+        let (gap, lambda, impulse) = (
+            c["gap"].as_f64().unwrap(),
+            c["lambda"].as_f64().unwrap(),
+            c["impulse"].as_f64().unwrap(),
+        );
+        assert!(gap.is_finite() && gap < 1e-3, "{c}");
+        assert!(lambda >= 0.0 && impulse >= 0.0 && lambda + impulse > 0.0, "{c}");
+        if lambda > 0.0 {
+            assert!(gap < 0.0, "a position correction only on a penetrating pair: {c}");
+        }
+    }
+    let vtu = std::fs::read_to_string(snap.join("frames/contacts.vtu")).unwrap();
+    assert!(
+        vtu.contains(&format!("NumberOfPoints=\"{}\"", contacts.len())),
+        "{vtu:.300}"
+    );
+    for field in [
+        "particle", "segment", "node", "gap", "lambda", "impulse", "dx", "dv", "recorded",
+    ] {
+        assert!(
+            vtu.contains(&format!("Name=\"{field}\"")),
+            "{field} missing from contacts.vtu"
+        );
+    }
     let particles = std::fs::read_to_string(snap.join("frames/particles_00000.vtu")).unwrap();
     assert!(particles.contains("NumberOfPoints=\""), "{particles:.200}");
 

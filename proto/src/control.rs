@@ -132,6 +132,26 @@ pub struct DebugState {
     pub sph_corrections: Vec<Correction>,
     /// Deepest penetration so far [m].
     pub max_penetration: f64,
+    /// The contacts the last contact pass recorded, each (particle, master) pair it acted on, as the algorithm
+    /// recorded them; `None` where the algorithm records none (`particle_particle`) or no pass ran since a restart.
+    pub contacts: Option<Vec<ContactRecord>>,
+}
+
+/// One (particle, master) pair the last particle–element pass acted on (`docs/PROTOCOL.md` §11).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactRecord {
+    /// Fluid particle id.
+    pub particle: u32,
+    /// The master: an interface segment (index into `fem/mesh` `interface`) ...
+    pub segment: Option<u32>,
+    /// ... or an interface node acting on its own (FE node id: convex corner, end of an open chain).
+    pub node: Option<u32>,
+    /// Gap g when the pass first acted on the pair [m] (negative: penetrating).
+    pub gap: f64,
+    /// Position multiplier λ applied to the pair, all sweeps [kg m] (`DESIGN.md` §4.5).
+    pub lambda: f64,
+    /// Velocity impulse J applied to the pair, all sweeps [kg m/s].
+    pub impulse: f64,
 }
 
 #[cfg(test)]

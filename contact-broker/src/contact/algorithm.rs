@@ -5,6 +5,7 @@
 
 use super::bodies::{Nodes, Particles, Segment};
 use super::error::ContactError;
+use super::particle_element::ContactPair;
 
 /// A fluid–structure contact algorithm: [`ParticleElement`](super::ParticleElement),
 /// [`ParticleParticle`](super::ParticleParticle), or `()` for none.
@@ -26,6 +27,12 @@ pub trait ContactAlgorithm: Send {
         segments: &[Segment],
         dt: f64,
     ) -> Result<PassReport, ContactError>;
+
+    /// The (particle, master) pairs the last pass acted on, where the algorithm records them (particle–element);
+    /// `None` where it does not.
+    fn pairs(&self) -> Option<&[ContactPair]> {
+        None
+    }
 }
 
 /// What one pass did, whatever the algorithm: what the run reports and the impulse the structure received.

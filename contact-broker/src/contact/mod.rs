@@ -63,7 +63,8 @@ pub use algorithm::{ContactAlgorithm, PassReport};
 pub use bodies::{Nodes, Particles, Segment};
 pub use error::ContactError;
 pub use particle_element::{
-    particle_element, particle_element_with, ContactParams, ContactReport, ParticleElement, ParticleElementWorkspace,
+    particle_element, particle_element_with, ContactPair, ContactParams, ContactReport, PairMaster, ParticleElement,
+    ParticleElementWorkspace,
 };
 pub use particle_particle::{
     particle_particle, particle_particle_with, ParticleParticle, ParticleParticleParams, ParticleParticleReport,

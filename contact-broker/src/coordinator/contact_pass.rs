@@ -62,6 +62,11 @@ impl ContactPass {
         })
     }
 
+    /// The contacts the last pass recorded ([`Interface::contacts`]); `None` without an interface or a record.
+    pub fn contacts(&self) -> Option<&[cosim_proto::control::ContactRecord]> {
+        self.interface.as_ref().and_then(|i| i.contacts())
+    }
+
     /// The commands of the next step, (fem, sph), carrying the pending corrections and the region of interest.
     pub fn commands(&mut self, dt: f64, want_snapshot: bool) -> (StepCommand, StepCommand) {
         let coupled = self.interface.is_some();

@@ -190,7 +190,14 @@ fn drive(
             // Between two steps, every node waiting for its next command: where a run pauses (`pause.rs`).
             if let Some(debugger) = debugger.as_deref_mut() {
                 let max_penetration = summary.contact_stats.max_penetration;
-                let mut halt = Halt::new(clock.step, clock.t, max_penetration, &contact.pending, nodes);
+                let mut halt = Halt::new(
+                    clock.step,
+                    clock.t,
+                    max_penetration,
+                    &contact.pending,
+                    contact.contacts(),
+                    nodes,
+                );
                 debugger.after_step(&mut halt).map_err(|why| {
                     anyhow::anyhow!("stopped after coupling step {} (t = {} s): {why}", clock.step, clock.t)
                 })?;
@@ -203,7 +210,14 @@ fn drive(
         let unstable = e.downcast_ref::<LinkError>().map(LinkError::status) == Some(RunStatus::Unstable);
         if let (true, Some(debugger)) = (unstable, debugger) {
             let max_penetration = summary.contact_stats.max_penetration;
-            let mut halt = Halt::new(clock.step, clock.t, max_penetration, &contact.pending, nodes);
+            let mut halt = Halt::new(
+                clock.step,
+                clock.t,
+                max_penetration,
+                &contact.pending,
+                contact.contacts(),
+                nodes,
+            );
             debugger.on_unstable(&mut halt, &format!("{e:#}").replace('\n', " "));
         }
         return Err(e);

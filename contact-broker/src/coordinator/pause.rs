@@ -7,7 +7,7 @@
 
 use std::time::Duration;
 
-use cosim_proto::control::{BreakCondition, ControlCommand, ControlReply, DebugState};
+use cosim_proto::control::{BreakCondition, ContactRecord, ControlCommand, ControlReply, DebugState};
 
 use super::inputs::Nodes;
 use crate::interface::Corrections;
@@ -27,6 +27,7 @@ pub struct Halt<'a, 'n> {
     /// `paused at step N: REASON`, empty while running.
     pub paused: String,
     pending: &'a Corrections,
+    contacts: Option<&'a [ContactRecord]>,
     nodes: &'a mut Nodes<'n>,
 }
 
@@ -36,6 +37,7 @@ impl<'a, 'n> Halt<'a, 'n> {
         t: f64,
         max_penetration: f64,
         pending: &'a Corrections,
+        contacts: Option<&'a [ContactRecord]>,
         nodes: &'a mut Nodes<'n>,
     ) -> Self {
         Self {
@@ -44,6 +46,7 @@ impl<'a, 'n> Halt<'a, 'n> {
             max_penetration,
             paused: String::new(),
             pending,
+            contacts,
             nodes,
         }
     }
@@ -66,6 +69,7 @@ impl<'a, 'n> Halt<'a, 'n> {
             fem_corrections: self.pending.fem.clone(),
             sph_corrections: self.pending.sph.clone(),
             max_penetration: self.max_penetration,
+            contacts: self.contacts.map(<[ContactRecord]>::to_vec),
         })
     }
 
@@ -280,7 +284,7 @@ mod tests {
         let pending = Corrections::default();
         for step in 1..=last {
             let mut nodes = Nodes { fem: None, sph: None };
-            let mut halt = Halt::new(step, 0.01 * step as f64, 0.0, &pending, &mut nodes);
+            let mut halt = Halt::new(step, 0.01 * step as f64, 0.0, &pending, None, &mut nodes);
             if debugger.after_step(&mut halt).is_err() {
                 return Some(step);
             }
@@ -329,7 +333,7 @@ mod tests {
     fn an_unstable_run_pauses_only_with_break_unstable_and_cannot_go_on() {
         let pending = Corrections::default();
         let mut nodes = Nodes { fem: None, sph: None };
-        let mut halt = Halt::new(7, 0.07, 0.0, &pending, &mut nodes);
+        let mut halt = Halt::new(7, 0.07, 0.0, &pending, None, &mut nodes);
         let mut quiet = Script::default();
         Debugger::new(Some(BreakCondition::Step(3)), &mut quiet).on_unstable(&mut halt, "blew up");
         assert!(quiet.shown.is_empty() && quiet.answers.is_empty());

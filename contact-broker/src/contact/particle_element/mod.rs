@@ -14,6 +14,7 @@
 //! [`ParticleElement`] is the [`ContactAlgorithm`] that runs it with its own [`ParticleElementWorkspace`].
 
 mod detection;
+mod pairs;
 mod params;
 mod position;
 mod projection;
@@ -27,6 +28,7 @@ mod workspace;
 #[cfg(test)]
 mod tests;
 
+pub use pairs::{ContactPair, PairMaster};
 pub use params::ContactParams;
 pub use report::ContactReport;
 pub use workspace::ParticleElementWorkspace;
@@ -34,6 +36,7 @@ pub use workspace::ParticleElementWorkspace;
 use crate::contact::algorithm::{ContactAlgorithm, PassReport};
 use crate::contact::bodies::{validate, Nodes, Particles, Segment};
 use crate::contact::error::ContactError;
+use pairs::Out;
 use setup::{Mark, Setup};
 
 /// Corrects particles and nodes in place (see the [module docs](super) for the algorithm) with a fresh workspace.
@@ -69,6 +72,7 @@ pub fn particle_element_with(
         ..ContactReport::default()
     };
     if particles.x.is_empty() || segments.is_empty() {
+        ws.pairs.clear();
         return Ok(report);
     }
     let ParticleElementWorkspace {
@@ -81,14 +85,39 @@ pub fn particle_element_with(
         contacts,
         planes,
         exhaustive,
+        pairs,
     } = ws;
+    pairs.clear();
     marks.clear();
     marks.resize(particles.x.len(), Mark::default());
 
     let setup = Setup::new(grid, topo, inv_m, &nodes, segments, params, *exhaustive);
-    position::phase(&setup, &mut particles, &mut nodes, masters, rigid, marks, &mut report);
+    position::phase(
+        &setup,
+        &mut particles,
+        &mut nodes,
+        masters,
+        rigid,
+        marks,
+        Out {
+            report: &mut report,
+            pairs,
+        },
+    );
     touching::collect(&setup, particles.x, nodes.x, marks, masters, contacts, &mut report);
-    velocity::phase(&setup, &mut particles, &mut nodes, contacts, planes, marks, &mut report);
+    velocity::phase(
+        &setup,
+        &mut particles,
+        &mut nodes,
+        contacts,
+        planes,
+        marks,
+        Out {
+            report: &mut report,
+            pairs,
+        },
+    );
+    pairs.finish();
 
     report.particles_corrected = marks.iter().filter(|m| m.corrected).count();
     Ok(report)
@@ -110,6 +139,11 @@ impl ParticleElement {
             workspace: ParticleElementWorkspace::default(),
         }
     }
+
+    /// The pairs the last pass acted on ([`ParticleElementWorkspace::pairs`]).
+    pub fn pairs(&self) -> &[ContactPair] {
+        self.workspace.pairs()
+    }
 }
 
 impl ContactAlgorithm for ParticleElement {
@@ -127,5 +161,9 @@ impl ContactAlgorithm for ParticleElement {
             max_penetration: report.max_penetration,
             node_impulse: report.node_impulse,
         })
+    }
+
+    fn pairs(&self) -> Option<&[ContactPair]> {
+        Some(self.workspace.pairs())
     }
 }

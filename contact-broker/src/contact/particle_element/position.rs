@@ -4,6 +4,7 @@
 //! (`projection.rs`).
 
 use super::detection::{Hit, Master};
+use super::pairs::Out;
 use super::projection;
 use super::report::ContactReport;
 use super::setup::{Mark, Setup};
@@ -25,8 +26,9 @@ pub(super) fn phase(
     masters: &mut Vec<Master>,
     rigid: &mut Vec<Master>,
     marks: &mut [Mark],
-    report: &mut ContactReport,
+    out: Out,
 ) {
+    let Out { report, pairs } = out;
     let pos_fixed = &*setup.pos_fixed;
     for sweep in 0..setup.params.sweeps {
         let first = sweep == 0;
@@ -60,11 +62,23 @@ pub(super) fn phase(
                 if first {
                     report.note_contact(m, h.g);
                 }
-                correct(setup, &h, im_s, &mut particles.x[s], nodes.x, report);
+                let lam = correct(setup, &h, im_s, &mut particles.x[s], nodes.x, report);
+                pairs.record(s, m, h.g, lam, 0.0);
                 mark.corrected = true;
             }
             // Immovable masters: the exact limit of the sweeps, per particle.
-            let projected = projection::position(setup, particles, s, nodes.x, rigid, first, report);
+            let projected = projection::position(
+                setup,
+                particles,
+                s,
+                nodes.x,
+                rigid,
+                first,
+                Out {
+                    report: &mut *report,
+                    pairs: &mut *pairs,
+                },
+            );
             worst = worst.max(projected.worst);
             if projected.near {
                 mark.clear = false;
@@ -83,8 +97,9 @@ pub(super) fn phase(
     }
 }
 
-/// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`.
-fn correct(setup: &Setup, h: &Hit, im_s: f64, x_s: &mut Vec2, node_x: &mut [Vec2], report: &mut ContactReport) {
+/// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`; the
+/// multiplier λ it applied.
+fn correct(setup: &Setup, h: &Hit, im_s: f64, x_s: &mut Vec2, node_x: &mut [Vec2], report: &mut ContactReport) -> f64 {
     let (inv_m, pos_fixed) = (setup.inv_m, &*setup.pos_fixed);
     // DESIGN.md §4.5: w = 1/m_s + N1²/m1 + N2²/m2 (a fixed node adds 0), λ = −g/w.
     let w = im_s + h.na * h.na * inv_m[h.a] + h.nb * h.nb * inv_m[h.b];
@@ -97,4 +112,5 @@ fn correct(setup: &Setup, h: &Hit, im_s: f64, x_s: &mut Vec2, node_x: &mut [Vec2
         }
         report.node_position_impulse[k] = axpy(report.node_position_impulse[k], -lam * nk, h.n);
     }
+    lam
 }

@@ -4,6 +4,7 @@
 //! inside the contact thickness and no contact approaching, whatever the corner angles.
 
 use super::detection::{Detector, Hit, Master};
+use super::pairs::{Out, PairLog};
 use super::report::ContactReport;
 use super::rigid::{position_step, velocity_step, HalfPlane};
 use super::setup::Setup;
@@ -37,8 +38,9 @@ pub(super) fn position(
     node_x: &[Vec2],
     rigid: &[Master],
     first: bool,
-    report: &mut ContactReport,
+    out: Out,
 ) -> Projected {
+    let Out { report, pairs } = out;
     let mut out = Projected::default();
     for step in 0..RIGID_STEPS {
         if rigid.is_empty() {
@@ -73,7 +75,10 @@ pub(super) fn position(
         // The particle's change m_s Δx is balanced by reactions −m_s μ_j N_a n_j on the fixed nodes.
         let delta = sub(st.x, x0);
         let m_s = particles.m[s];
-        for (h, mu) in split(&d, rigid, st.by, st.x, delta) {
+        for (m, h, mu) in split(&d, rigid, st.by, st.x, delta) {
+            // λ = m_s μ: the particle moved by μ = λ/m_s along n_j; the gap is the master's at x0.
+            let g0 = d.detect(m, x0).map_or(h.g, |h0| h0.g);
+            pairs.record(s, m, g0, m_s * mu, 0.0);
             for (k, nk) in [(h.a, h.na), (h.b, h.nb)] {
                 report.node_position_impulse[k] = axpy(report.node_position_impulse[k], -m_s * mu * nk, h.n);
             }
@@ -89,6 +94,7 @@ pub(super) fn position(
 pub(super) struct Planes {
     planes: Vec<HalfPlane>,
     hits: Vec<Hit>,
+    masters: Vec<Master>,
 }
 
 impl Planes {
@@ -96,12 +102,14 @@ impl Planes {
     pub fn clear(&mut self) {
         self.planes.clear();
         self.hits.clear();
+        self.masters.clear();
     }
 
-    /// Adds the contact `h` with a master moving at `u` (its prescribed velocity at the contact point).
-    pub fn push(&mut self, h: Hit, u: Vec2) {
+    /// Adds the contact `h` with master `m` moving at `u` (its prescribed velocity at the contact point).
+    pub fn push(&mut self, h: Hit, m: Master, u: Vec2) {
         self.planes.push(HalfPlane { n: h.n, c: dot(h.n, u) });
         self.hits.push(h);
+        self.masters.push(m);
     }
 }
 
@@ -112,6 +120,7 @@ pub(super) fn velocity(
     s: usize,
     m_s: f64,
     planes: &Planes,
+    pairs: &mut PairLog,
     report: &mut ContactReport,
 ) -> (f64, bool) {
     let (mut worst, mut moved) = (0.0f64, false);
@@ -128,6 +137,8 @@ pub(super) fn velocity(
         };
         for (pi, mu) in st.by.into_iter().flatten() {
             let h = planes.hits[pi];
+            // J = m_s μ along n_j.
+            pairs.record(s, planes.masters[pi], h.g, 0.0, m_s * mu);
             for (k, nk) in [(h.a, h.na), (h.b, h.nb)] {
                 report.node_impulse[k] = axpy(report.node_impulse[k], -m_s * mu * nk, h.n);
             }
@@ -139,23 +150,26 @@ pub(super) fn velocity(
 }
 
 /// Splits a particle's change `delta` at position `at` along the normals of the (one or two) masters that define
-/// it: delta = Σ μ_j n_j, each with its contact geometry (N_a at `at`, unclamped, so x_s − x_c ∥ n_j holds).
+/// it: delta = Σ μ_j n_j, each with its master and contact geometry (N_a at `at`, unclamped, so x_s − x_c ∥ n_j
+/// holds).
 fn split(
     d: &Detector,
     masters: &[Master],
     by: [Option<usize>; 2],
     at: Vec2,
     delta: Vec2,
-) -> impl Iterator<Item = (Hit, f64)> {
-    let hits = by.map(|i| i.and_then(|i| d.attach(masters[i], at)).map(|(h, _)| h));
+) -> impl Iterator<Item = (Master, Hit, f64)> {
+    let hits = by.map(|i| i.and_then(|i| d.attach(masters[i], at).map(|(h, _)| (masters[i], h))));
     let mus = match hits {
-        [Some(h1), Some(h2)] if cross(h1.n, h2.n).abs() > 1e-12 => {
+        [Some((_, h1)), Some((_, h2))] if cross(h1.n, h2.n).abs() > 1e-12 => {
             let det = cross(h1.n, h2.n);
             [cross(delta, h2.n) / det, cross(h1.n, delta) / det]
         }
-        [Some(h1), _] => [dot(delta, h1.n), 0.0],
+        [Some((_, h1)), _] => [dot(delta, h1.n), 0.0],
         _ => [0.0, 0.0],
     };
     let keep = [hits[0], if mus[1] != 0.0 { hits[1] } else { None }];
-    keep.into_iter().zip(mus).filter_map(|(h, mu)| h.map(|h| (h, mu)))
+    keep.into_iter()
+        .zip(mus)
+        .filter_map(|(h, mu)| h.map(|(m, h)| (m, h, mu)))
 }

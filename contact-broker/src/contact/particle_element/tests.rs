@@ -207,3 +207,94 @@ proptest::proptest! {
         proptest::prop_assert_eq!(strip(&fast.6), strip(&full.6));
     }
 }
+
+/// One particle 0.03 under a horizontal segment (thickness 0.05, so g = −0.02), from below at v = (0.4, 2.0):
+/// the case of `single_contact_matches_the_formulas`, with the nodes free or fixed; the pass's record of the pair.
+fn one_pair(fixed: [bool; 2]) -> (ParticleElementWorkspace, Vec2, Vec2) {
+    let mut px = [[0.25, -0.03]];
+    let mut pv = [[0.4, 2.0]];
+    let pm = [1.0];
+    let mut nx = [[0.0, 0.0], [1.0, 0.0]];
+    let mut nv = [[0.0, 0.0], [0.0, -1.0]];
+    if fixed[0] {
+        nv = [[0.0; 2]; 2];
+    }
+    let nm = [2.0, 4.0];
+    let params = ContactParams {
+        thickness: 0.05,
+        far_side: 0.2,
+        sweeps: 1,
+        tolerance: 0.0,
+        move_masters: true,
+    };
+    let mut ws = ParticleElementWorkspace::default();
+    let p = Particles {
+        x: &mut px,
+        v: &mut pv,
+        m: &pm,
+    };
+    let n = Nodes {
+        x: &mut nx,
+        v: &mut nv,
+        m: &nm,
+        fixed: &fixed,
+    };
+    particle_element_with(&mut ws, p, n, &[Segment { a: 0, b: 1 }], &params).unwrap();
+    (ws, px[0], pv[0])
+}
+
+#[test]
+fn the_pass_records_its_pair_with_gap_lambda_and_impulse() {
+    // Free nodes: λ = −g/w, w = 1/m_s + N1²/m1 + N2²/m2 (DESIGN.md §4.5, Long et al. 2016 after Johnson & Stryk
+    // 2001); J = −v_rel/w' at the corrected geometry, which the particle's Δv·n' shows (Δv ∥ n').
+    let (ws, x, v) = one_pair([false, false]);
+    let pairs = ws.pairs();
+    assert_eq!(pairs.len(), 1, "{pairs:?}");
+    let p = pairs[0];
+    assert_eq!((p.particle, p.master), (0, PairMaster::Segment(0)));
+    assert!((p.gap - (-0.02)).abs() < 1e-15, "gap {}", p.gap);
+    let w = 1.0 + 0.5625 / 2.0 + 0.0625 / 4.0;
+    assert!((p.lambda - 0.02 / w).abs() < 1e-15, "λ {}", p.lambda);
+    // m_s = 1: the particle moved by λ along n = (0, −1), and its velocity changed by J along n' ≈ n.
+    assert!((x[1] - (-0.03 - p.lambda)).abs() < 1e-15);
+    let dv = [v[0] - 0.4, v[1] - 2.0];
+    assert!(
+        (dv[0].hypot(dv[1]) - p.impulse).abs() < 1e-14,
+        "J {} vs |Δv| {:?}",
+        p.impulse,
+        dv
+    );
+    assert!(
+        (p.impulse - 2.25 / w).abs() < 2e-3 * p.impulse,
+        "close to the undeformed value"
+    );
+
+    // Fixed nodes: the exact projection (projection.rs): μ = −g along n, λ = m_s μ = 0.02; J = m_s·(−v_rel) = 2.
+    let (ws, x, v) = one_pair([true, true]);
+    let pairs = ws.pairs();
+    assert_eq!(pairs.len(), 1, "{pairs:?}");
+    let p = pairs[0];
+    assert_eq!((p.particle, p.master), (0, PairMaster::Segment(0)));
+    assert!((p.gap - (-0.02)).abs() < 1e-15, "gap {}", p.gap);
+    assert!((p.lambda - 0.02).abs() < 1e-15, "λ {}", p.lambda);
+    assert!((p.impulse - 2.0).abs() < 1e-14, "J {}", p.impulse);
+    assert!((x[1] - (-0.05)).abs() < 1e-15 && v[1].abs() < 1e-14 && v[0] == 0.4);
+
+    // Nothing touched: no pairs, and the previous pass's are gone.
+    let mut ws = ws;
+    let (mut px, mut pv, pm) = ([[0.25, -0.5]], [[0.0, 0.0]], [1.0]);
+    let (mut nx, mut nv) = ([[0.0, 0.0], [1.0, 0.0]], [[0.0; 2]; 2]);
+    let p = Particles {
+        x: &mut px,
+        v: &mut pv,
+        m: &pm,
+    };
+    let n = Nodes {
+        x: &mut nx,
+        v: &mut nv,
+        m: &[2.0, 4.0],
+        fixed: &[false, false],
+    };
+    particle_element_with(&mut ws, p, n, &[Segment { a: 0, b: 1 }], &ContactParams::default()).unwrap();
+    assert!(ws.pairs().is_empty());
+}

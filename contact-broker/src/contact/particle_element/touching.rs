@@ -13,6 +13,8 @@ pub(super) struct Contact {
     pub s: usize,
     /// Its geometry at the corrected positions.
     pub hit: Hit,
+    /// Its master.
+    pub master: Master,
     /// The master cannot move (all its nodes fixed).
     pub rigid: bool,
 }
@@ -42,6 +44,7 @@ pub(super) fn collect(
                 contacts.push(Contact {
                     s,
                     hit,
+                    master: m,
                     rigid: d.is_rigid(m, setup.fixed),
                 });
             }

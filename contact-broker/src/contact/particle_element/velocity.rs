@@ -3,6 +3,7 @@
 //! limit of the sweeps instead (`projection.rs`). Tangential velocity is untouched (free slip).
 
 use super::detection::Hit;
+use super::pairs::Out;
 use super::projection::{self, Planes};
 use super::report::ContactReport;
 use super::setup::{Mark, Setup};
@@ -20,8 +21,9 @@ pub(super) fn phase(
     contacts: &[Contact],
     planes: &mut Planes,
     marks: &mut [Mark],
-    report: &mut ContactReport,
+    out: Out,
 ) {
+    let Out { report, pairs } = out;
     let mut v_scale = 0.0;
     for sweep in 0..if contacts.is_empty() { 0 } else { setup.params.sweeps } {
         let mut worst = 0.0f64;
@@ -36,7 +38,7 @@ pub(super) fn phase(
                 if c.rigid {
                     // n·v_s ≥ n·u with u = N1 v1 + N2 v2 the (prescribed) master velocity.
                     let u = axpy(scale(nodes.v[h.a], h.na), h.nb, nodes.v[h.b]);
-                    planes.push(h, u);
+                    planes.push(h, c.master, u);
                     continue;
                 }
                 // v_rel = (v_s − N1 v1 − N2 v2)·n; only approaching contacts are corrected.
@@ -46,11 +48,12 @@ pub(super) fn phase(
                     continue;
                 }
                 worst = worst.max(-v_rel);
-                impulse(setup, &h, v_rel, im_s, &mut particles.v[s], nodes.v, report);
+                let j = impulse(setup, &h, v_rel, im_s, &mut particles.v[s], nodes.v, report);
+                pairs.record(s, c.master, h.g, 0.0, j);
                 marks[s].corrected = true;
             }
             // Immovable masters: exact per particle.
-            let (approach, moved) = projection::velocity(particles, s, m_s, planes, report);
+            let (approach, moved) = projection::velocity(particles, s, m_s, planes, pairs, report);
             worst = worst.max(approach);
             if moved {
                 marks[s].corrected = true;
@@ -68,7 +71,7 @@ pub(super) fn phase(
 }
 
 /// The impulse on one approaching contact `h` (relative normal velocity `v_rel` < 0) of a particle with inverse
-/// mass `im_s` and velocity `v_s`.
+/// mass `im_s` and velocity `v_s`; the impulse J it applied.
 fn impulse(
     setup: &Setup,
     h: &Hit,
@@ -77,7 +80,7 @@ fn impulse(
     v_s: &mut Vec2,
     node_v: &mut [Vec2],
     report: &mut ContactReport,
-) {
+) -> f64 {
     let (inv_m, fixed) = (setup.inv_m, setup.fixed);
     // J = −v_rel/w; v_s += (J/m_s) n; v1 −= (J N1/m1) n; v2 −= (J N2/m2) n.
     let w = im_s + h.na * h.na * inv_m[h.a] + h.nb * h.nb * inv_m[h.b];
@@ -89,4 +92,5 @@ fn impulse(
         }
         report.node_impulse[k] = axpy(report.node_impulse[k], -j * nk, h.n);
     }
+    j
 }

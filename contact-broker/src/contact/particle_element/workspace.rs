@@ -1,6 +1,7 @@
 //! The scratch memory of the particle–element pass (`DESIGN.md` §2: state apart from scratch).
 
 use super::detection::{Master, Topology};
+use super::pairs::{ContactPair, PairLog};
 use super::projection::Planes;
 use super::setup::Mark;
 use super::touching::Contact;
@@ -8,7 +9,7 @@ use crate::contact::grid::CellGrid;
 
 /// Scratch arrays of [`particle_element_with`](super::particle_element_with): keep one per caller and pass it to
 /// every call so the arrays are allocated once. Holds no state between calls: results never depend on what it held
-/// before. Not serialisable, by design.
+/// before (the last pass's pairs are kept for reading only). Not serialisable, by design.
 #[derive(Clone, Debug, Default)]
 pub struct ParticleElementWorkspace {
     /// The segments binned in cells (set-up).
@@ -29,4 +30,14 @@ pub struct ParticleElementWorkspace {
     pub(super) planes: Planes,
     /// Visit every particle in every sweep even where the nodes are static (tests compare the two).
     pub(super) exhaustive: bool,
+    /// The pairs the last pass acted on (kept after the pass: [`ParticleElementWorkspace::pairs`]).
+    pub(super) pairs: PairLog,
+}
+
+impl ParticleElementWorkspace {
+    /// Each (particle, master) pair the last pass acted on, ordered by particle then master, with its gap at
+    /// detection and the λ and J applied to it ([`ContactPair`]). Empty before the first pass.
+    pub fn pairs(&self) -> &[ContactPair] {
+        self.pairs.pairs()
+    }
 }
