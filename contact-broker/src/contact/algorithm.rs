@@ -5,7 +5,7 @@
 
 use super::bodies::{Nodes, Particles, Segment};
 use super::error::ContactError;
-use super::particle_element::ContactPair;
+use super::pair::ContactPair;
 
 /// A fluid–structure contact algorithm: [`ParticleElement`](super::ParticleElement),
 /// [`ParticleParticle`](super::ParticleParticle), or `()` for none.

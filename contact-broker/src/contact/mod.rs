@@ -56,6 +56,7 @@ mod bodies;
 mod error;
 mod geometry;
 mod grid;
+mod pair;
 mod particle_element;
 mod particle_particle;
 

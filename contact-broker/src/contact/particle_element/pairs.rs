@@ -5,16 +5,7 @@
 //! allocation once the vector has grown to a step's size. Only read, never fed back: the physics does not see it.
 
 use super::detection::Master;
-
-/// The master of a [`ContactPair`]: a boundary segment (index into the pass's segments), or a boundary node acting
-/// on its own (convex corner, end of an open chain).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum PairMaster {
-    /// Segment index.
-    Segment(u32),
-    /// Node index.
-    Node(u32),
-}
+pub use crate::contact::pair::{ContactPair, PairMaster};
 
 impl From<Master> for PairMaster {
     fn from(m: Master) -> Self {
@@ -23,24 +14,6 @@ impl From<Master> for PairMaster {
             Master::Node(k) => PairMaster::Node(k),
         }
     }
-}
-
-/// One (particle, master) pair the last pass acted on.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactPair {
-    /// The particle (index into the pass's particles).
-    pub particle: usize,
-    /// The master.
-    pub master: PairMaster,
-    /// Gap g when the pass first acted on the pair [m] (negative: penetrating): at the particle's position when
-    /// detected in the position phase, or in the touching set for a pair only the velocity phase acted on.
-    pub gap: f64,
-    /// Position multiplier λ applied to the pair, all sweeps [kg m]: the particle moved by λ/m_s along the
-    /// contact normal (λ = −g/w, `DESIGN.md` §4.5; against an immovable master m_s μ, `projection.rs`).
-    pub lambda: f64,
-    /// Velocity impulse J applied to the pair, all sweeps [kg m/s] (J = −v_rel/w, `DESIGN.md` §4.5; against an
-    /// immovable master m_s μ).
-    pub impulse: f64,
 }
 
 /// Where a phase writes what it did: the pass's report and its pair log.
