@@ -189,15 +189,7 @@ fn drive(
             checkpointing::save_if_due(&mut checkpoints, &step, state, scene, nodes, info)?;
             // Between two steps, every node waiting for its next command: where a run pauses (`pause.rs`).
             if let Some(debugger) = debugger.as_deref_mut() {
-                let max_penetration = summary.contact_stats.max_penetration;
-                let mut halt = Halt::new(
-                    clock.step,
-                    clock.t,
-                    max_penetration,
-                    &contact.pending,
-                    contact.contacts(),
-                    nodes,
-                );
+                let mut halt = halt_now(&clock, summary, &contact, nodes);
                 debugger.after_step(&mut halt).map_err(|why| {
                     anyhow::anyhow!("stopped after coupling step {} (t = {} s): {why}", clock.step, clock.t)
                 })?;
@@ -209,15 +201,7 @@ fn drive(
         // `--break unstable`: a blow-up pauses the run where it happened, every process alive, until it is stopped.
         let unstable = e.downcast_ref::<LinkError>().map(LinkError::status) == Some(RunStatus::Unstable);
         if let (true, Some(debugger)) = (unstable, debugger) {
-            let max_penetration = summary.contact_stats.max_penetration;
-            let mut halt = Halt::new(
-                clock.step,
-                clock.t,
-                max_penetration,
-                &contact.pending,
-                contact.contacts(),
-                nodes,
-            );
+            let mut halt = halt_now(&clock, summary, &contact, nodes);
             debugger.on_unstable(&mut halt, &format!("{e:#}").replace('\n', " "));
         }
         return Err(e);
@@ -241,4 +225,22 @@ fn collect_counts(nodes: &mut Nodes<'_>, summary: &mut Summary) {
 /// it is written however full the disk got; an error names the file.
 pub fn write_summary(out: &Path, summary: &Summary) -> anyhow::Result<()> {
     Ok(crate::summary::write(out, summary)?)
+}
+
+/// The run as it stands between two steps, for the debugger (`pause.rs`).
+fn halt_now<'a, 'n>(
+    clock: &Clock,
+    summary: &Summary,
+    contact: &'a ContactPass,
+    nodes: &'a mut Nodes<'n>,
+) -> Halt<'a, 'n> {
+    let max_penetration = summary.contact_stats.max_penetration;
+    Halt::new(
+        clock.step,
+        clock.t,
+        max_penetration,
+        &contact.pending,
+        contact.contacts(),
+        nodes,
+    )
 }
