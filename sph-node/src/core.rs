@@ -204,6 +204,37 @@ impl SphCore {
         Ok(())
     }
 
+    /// Advances the fluid by `dt` in sub-steps of its own stable step; how many.
+    fn subcycle(&mut self, dt: f64) -> Result<u32, SphError> {
+        let mut substeps = 0u32;
+        // Sub-cycle at the solver's own adaptive stable step (one step when the broker already capped dt by it).
+        let mut done = 0.0;
+        while done < dt {
+            let (stable, left) = (self.solver.stable_dt(), dt - done);
+            let mut h = stable.min(left);
+            if self.solver.equal_substeps() && left > stable {
+                // ISPH: equal sub-steps, not full steps and a remainder. Its pressure carries 1/Δt (the PPE source
+                // ∇·u*/Δt and the walls' Neumann rows ρ u*·n/Δt: the impulse Δt ∇p/ρ is what the projection
+                // fixes), so a remainder step multiplies it by Δt_own/Δt: the Lobovsky dam break at H/30 took
+                // remainders down to 7.4e-7 s (own step 1e-3 s; 411 ρgH in a fluid particle, −1585 before the
+                // clip), and its probes, sampled after the last sub-step, read only remainders (docs/CORRECTIONS.md,
+                // "ISPH pressure"). WCSPH keeps full steps and a remainder (its pressure is the state's).
+                h = left / (left / stable).ceil();
+            }
+            if dt - done - h <= 1e-9 * h {
+                h = dt - done;
+            }
+            self.solver.step(h)?;
+            if !self.sensors.is_empty() {
+                self.sensors
+                    .after_step(&pressure_field(self.solver.as_ref(), &self.setup), h);
+            }
+            substeps += 1;
+            done += h;
+        }
+        Ok(substeps)
+    }
+
     /// Apply the corrections, advance by `dt` (in as many stable steps as it takes) and answer. `None` for a stop.
     pub fn handle(&mut self, cmd: &StepCommand) -> Result<Option<SphState>, SphError> {
         let started = Instant::now();
@@ -218,32 +249,11 @@ impl SphCore {
         if cmd.stop {
             return Ok(None);
         }
-        let mut substeps = 0u32;
-        // Sub-cycle at the solver's own adaptive stable step (one step when the broker already capped dt by it).
-        let mut done = 0.0;
-        while done < cmd.dt {
-            let (stable, left) = (self.solver.stable_dt(), cmd.dt - done);
-            let mut h = stable.min(left);
-            if self.solver.equal_substeps() && left > stable {
-                // ISPH: equal sub-steps, not full steps and a remainder. Its pressure carries 1/Δt (the PPE source
-                // ∇·u*/Δt and the walls' Neumann rows ρ u*·n/Δt: the impulse Δt ∇p/ρ is what the projection
-                // fixes), so a remainder step multiplies it by Δt_own/Δt: the Lobovsky dam break at H/30 took
-                // remainders down to 7.4e-7 s (own step 1e-3 s; 411 ρgH in a fluid particle, −1585 before the
-                // clip), and its probes, sampled after the last sub-step, read only remainders (docs/CORRECTIONS.md,
-                // "ISPH pressure"). WCSPH keeps full steps and a remainder (its pressure is the state's).
-                h = left / (left / stable).ceil();
-            }
-            if cmd.dt - done - h <= 1e-9 * h {
-                h = cmd.dt - done;
-            }
-            self.solver.step(h)?;
-            if !self.sensors.is_empty() {
-                self.sensors
-                    .after_step(&pressure_field(self.solver.as_ref(), &self.setup), h);
-            }
-            substeps += 1;
-            done += h;
-        }
+        // The whole sub-cycle runs on a worker of the rayon pool: every pass of a step is a parallel loop, and one
+        // started from a thread outside the pool hands its work to a worker and sleeps until it is done, two
+        // context switches a pass (about 70 a WCSPH step at `--threads 1`, issue 20). Started from a worker, the
+        // loops run where they are, split as before: the same bits.
+        let substeps = rayon::scope(|_| self.subcycle(cmd.dt))?;
         if substeps > 0 {
             self.guard.check(self.solver.state())?;
         }
