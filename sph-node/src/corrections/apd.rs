@@ -38,6 +38,7 @@
 
 use rayon::prelude::*;
 
+use crate::corrections::xsph;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
@@ -93,7 +94,16 @@ pub fn apd_shift(
     p: &ApdParams,
 ) -> [f64; 2] {
     let vol = |j: usize| view.m[j] / view.rho[j];
-    apd_shift_with(i, view, neighbors, kernel, p, vol, |_, r_ij, r| kernel.grad(r_ij, r))
+    apd_shift_with(
+        i,
+        view,
+        neighbors,
+        kernel,
+        p,
+        vol,
+        |_, r_ij, r| kernel.grad(r_ij, r),
+        |_, _| (),
+    )
 }
 
 /// [`apd_shift`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair (i, `neighbors[k]`),
@@ -110,12 +120,39 @@ pub fn apd_shift_pairs(
     p: &ApdParams,
 ) -> [f64; 2] {
     let grad_of = |k: usize, r_ij: [f64; 2], _| [grad[k] * r_ij[0], grad[k] * r_ij[1]];
-    apd_shift_with(i, view, neighbors, kernel, p, |j| vol[j], grad_of)
+    apd_shift_with(i, view, neighbors, kernel, p, |j| vol[j], grad_of, |_, _| ())
+}
+
+/// [`apd_shift_pairs`] and the XSPH correction of particle i with coefficient `eps`
+/// ([`crate::corrections::xsph::xsph_correction`]) in one loop over the pairs: both are taken at xⁿ from the same
+/// state, and share the separation and W_ij of each pair. The same two results, bit for bit, as the two passes.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn apd_xsph_pairs(
+    i: usize,
+    view: &ParticleView<'_>,
+    vol: &[f64],
+    neighbors: &[u32],
+    grad: &[f64],
+    kernel: &CubicSpline,
+    p: &ApdParams,
+    eps: f64,
+) -> ([f64; 2], [f64; 2]) {
+    let grad_of = |k: usize, r_ij: [f64; 2], _| [grad[k] * r_ij[0], grad[k] * r_ij[1]];
+    let mut s = [0.0, 0.0];
+    let xsph = |j: usize, w: f64| {
+        if j < view.n_fluid {
+            xsph::add_term(&mut s, view, i, j, w);
+        }
+    };
+    let shift = apd_shift_with(i, view, neighbors, kernel, p, |j| vol[j], grad_of, xsph);
+    (shift, xsph::finish(s, eps))
 }
 
 /// The shift of [`apd_shift`], with V_j from `vol_of(j)` and ∇_i W_ij of the k-th neighbour from
-/// `grad_of(k, r_ij, r)`.
+/// `grad_of(k, r_ij, r)`; `pair(j, W_ij)` is called for every neighbour j, in order (a pass that shares the loop).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn apd_shift_with(
     i: usize,
     view: &ParticleView<'_>,
@@ -124,15 +161,19 @@ fn apd_shift_with(
     p: &ApdParams,
     vol_of: impl Fn(usize) -> f64,
     grad_of: impl Fn(usize, [f64; 2], f64) -> [f64; 2],
+    mut pair: impl FnMut(usize, f64),
 ) -> [f64; 2] {
     let xi = view.x[i];
     // Sun et al. 2017, Eq. (7): W(Δx), here at the local spacing Δx_i = sqrt(m_i/ρ_i)
-    let w_dx = kernel.w((view.m[i] / view.rho[i]).sqrt());
+    // 1/W(Δx_i), once a particle: a multiplication a pair where W_ij/W(Δx_i) was a division (issue 20)
+    let inv_w_dx = 1.0 / kernel.w((view.m[i] / view.rho[i]).sqrt());
     let (mut div_r, mut s, mut fluid) = (0.0, [0.0, 0.0], [0.0, 0.0]);
     for (k, &j) in neighbors.iter().enumerate() {
         let j = j as usize;
         let (r_ij, r) = separation(xi, view.x[j]);
         let g = grad_of(k, r_ij, r);
+        let w = kernel.w(r);
+        pair(j, w);
         let v_j = vol_of(j);
         // Lind et al. 2012, Eq. (15): ∇·r = Σ_j V_j (r_j − r_i)·∇_i W_ij (as `position_divergence`)
         div_r -= v_j * dot(r_ij, g);
@@ -144,7 +185,7 @@ fn apd_shift_with(
             fluid[1] += v_j * g[1];
         }
         // Sun et al. 2017, Eq. (7): [1 + R (W_ij/W(Δx))^n] V_j ∇_i W_ij, n = 4 (R: `R_PAIRING`)
-        let q = kernel.w(r) / w_dx;
+        let q = w * inv_w_dx;
         let f = v_j * (1.0 + R_PAIRING * q * q * q * q);
         s[0] += f * g[0];
         s[1] += f * g[1];
@@ -166,10 +207,10 @@ fn apd_shift_with(
             d = [d[0] - dn * n[0], d[1] - dn * n[1]];
         }
     }
-    // DESIGN.md §4.4: |δr| ≤ 0.05 h
-    let len = d[0].hypot(d[1]);
+    // DESIGN.md §4.4: |δr| ≤ 0.05 h (compared squared: no square root for a shift within the cap)
     let cap = SHIFT_CAP * kernel.h();
-    if len > cap {
+    if dot(d, d) > cap * cap {
+        let len = d[0].hypot(d[1]);
         [d[0] * cap / len, d[1] * cap / len]
     } else {
         d
@@ -203,6 +244,24 @@ pub fn apd_pairs_into(
 ) {
     list.map_pairs_into(out, |i, idx, grad| {
         apd_shift_pairs(i, view, vol, idx, grad, kernel, params)
+    });
+}
+
+/// [`apd_pairs_into`] and [`crate::corrections::xsph::xsph_into`] with coefficient `eps` in one pass
+/// ([`apd_xsph_pairs`]): the shifts into `shift`, the XSPH corrections into `xsph`, bit for bit those of the two.
+#[allow(clippy::too_many_arguments)]
+pub fn apd_xsph_pairs_into(
+    view: &ParticleView<'_>,
+    vol: &[f64],
+    list: &NeighborList,
+    kernel: &CubicSpline,
+    params: &ApdParams,
+    eps: f64,
+    shift: &mut Vec<[f64; 2]>,
+    xsph: &mut Vec<[f64; 2]>,
+) {
+    list.map_pairs_into2(shift, xsph, |i, idx, grad| {
+        apd_xsph_pairs(i, view, vol, idx, grad, kernel, params, eps)
     });
 }
 

@@ -15,7 +15,7 @@ pub fn xsph_correction(
     kernel: &CubicSpline,
     eps: f64,
 ) -> [f64; 2] {
-    let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
+    let xi = view.x[i];
     let mut s = [0.0, 0.0];
     for &j in neighbors {
         let j = j as usize;
@@ -23,11 +23,24 @@ pub fn xsph_correction(
             continue;
         }
         let (_, r) = separation(xi, view.x[j]);
-        // §4.4 XSPH
-        let f = view.m[j] / (0.5 * (rho_i + view.rho[j])) * kernel.w(r);
-        s[0] += f * (vi[0] - view.v[j][0]);
-        s[1] += f * (vi[1] - view.v[j][1]);
+        add_term(&mut s, view, i, j, kernel.w(r));
     }
+    finish(s, eps)
+}
+
+/// s += (m_j/ρ̄_ij) v_ij W_ij, the term of fluid neighbour j (`w` = W_ij) in the XSPH sum of particle i.
+#[inline(always)]
+pub fn add_term(s: &mut [f64; 2], view: &ParticleView<'_>, i: usize, j: usize, w: f64) {
+    let (vi, rho_i) = (view.v[i], view.rho[i]);
+    // §4.4 XSPH
+    let f = view.m[j] / (0.5 * (rho_i + view.rho[j])) * w;
+    s[0] += f * (vi[0] - view.v[j][0]);
+    s[1] += f * (vi[1] - view.v[j][1]);
+}
+
+/// The correction −ε s from the sum s of [`add_term`].
+#[inline(always)]
+pub fn finish(s: [f64; 2], eps: f64) -> [f64; 2] {
     [-eps * s[0], -eps * s[1]]
 }
 

@@ -338,6 +338,28 @@ impl NeighborList {
             });
     }
 
+    /// [`NeighborList::map_pairs_into`] for a pass with two results per particle: `(a[i], b[i]) = f(i, …)`.
+    pub fn map_pairs_into2<A, B, F>(&self, a: &mut Vec<A>, b: &mut Vec<B>, f: F)
+    where
+        A: Copy + Default + Send,
+        B: Copy + Default + Send,
+        F: Fn(usize, &[u32], &[f64]) -> (A, B) + Sync,
+    {
+        a.resize(self.n, A::default()); // every entry is overwritten
+        b.resize(self.n, B::default());
+        a.par_chunks_mut(CHUNK)
+            .zip(b.par_chunks_mut(CHUNK))
+            .zip(self.chunks.par_iter())
+            .for_each(|((a, b), chunk)| {
+                let grad = chunk.grad();
+                for (k, (a, b)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+                    let r = chunk.range(k);
+                    let g = if grad.is_empty() { &[][..] } else { &grad[r.clone()] };
+                    (*a, *b) = f(chunk.first() + k, &chunk.idx[r], g);
+                }
+            });
+    }
+
     /// Neighbours of particle i.
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {

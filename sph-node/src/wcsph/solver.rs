@@ -330,42 +330,36 @@ impl WcsphSolver {
         // Density drifts with the positions: its rate uses v^{n+½} at both ends of the step (trapezoid in x).
         // A rate kept from the previous step (v^{n−½}) would make the acoustic modes grow.
         self.density_half_kick(dt);
-        // Drift (XSPH at the old positions with the half-step velocities).
+        // Drift (XSPH at the old positions with the half-step velocities), and APD (§4.4; Xu et al. 2009,
+        // Eq. (35)) at xⁿ, with the neighbours of the last search; the shift joins the drift below, so that the
+        // positions are searched once a step (DualSPHysics applies its shifting with the position update in the
+        // same way). Both from the same state: with both on, one pass over the pairs computes the two.
         let mut corr = std::mem::take(&mut self.scratch.per2);
         corr.clear();
-        if self.params.xsph > 0.0 {
-            xsph::xsph_into(
-                &self.view(),
-                &self.scratch.list,
-                &self.kernel,
-                self.params.xsph,
-                &mut corr,
-            );
-        }
-        // APD (§4.4; Xu et al. 2009, Eq. (35)) at x^n, with the neighbours of the last search; the shift joins the
-        // drift below, so that the positions are searched once a step (DualSPHysics applies its shifting with the
-        // position update in the same way).
         let mut shift = std::mem::take(&mut self.scratch.shift);
         shift.clear();
-        if self.wcsph.apd > 0.0 {
-            let v_max = max_norm(&self.sorted.v[..nf]);
-            if v_max > 0.0 {
-                let apd_params = apd::ApdParams {
-                    beta: self.wcsph.apd,
-                    v_max,
-                    dt,
-                };
-                apd::apd_pairs_into(
-                    &self.view(),
-                    &self.sorted.vol,
-                    &self.scratch.list,
-                    &self.kernel,
-                    &apd_params,
-                    &mut shift,
-                );
-                // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
-                self.density_follows_shift(&shift);
+        let v_max = if self.wcsph.apd > 0.0 {
+            max_norm(&self.sorted.v[..nf])
+        } else {
+            0.0
+        };
+        let apd_params = (v_max > 0.0).then_some(apd::ApdParams {
+            beta: self.wcsph.apd,
+            v_max,
+            dt,
+        });
+        let (view, vol, list, kernel) = (self.view(), &self.sorted.vol, &self.scratch.list, &self.kernel);
+        match (self.params.xsph > 0.0, &apd_params) {
+            (true, Some(a)) => {
+                apd::apd_xsph_pairs_into(&view, vol, list, kernel, a, self.params.xsph, &mut shift, &mut corr)
             }
+            (true, None) => xsph::xsph_into(&view, list, kernel, self.params.xsph, &mut corr),
+            (false, Some(a)) => apd::apd_pairs_into(&view, vol, list, kernel, a, &mut shift),
+            (false, None) => {}
+        }
+        if apd_params.is_some() {
+            // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
+            self.density_follows_shift(&shift);
         }
         let s = &mut self.sorted;
         if !self.scratch.edited_x.is_empty() {

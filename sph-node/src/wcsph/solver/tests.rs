@@ -127,6 +127,29 @@ fn fast_passes_equal_the_reference_gathers() {
         .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
         .collect();
     assert_eq!(bits(&xsph), bits(&expected));
+    // APD and XSPH in one pass: both results, bit for bit those of the separate passes.
+    let ap = apd::ApdParams {
+        beta: 0.04,
+        v_max: 1.0,
+        dt: 1e-4,
+    };
+    let (mut shift, mut both) = (Vec::new(), Vec::new());
+    apd::apd_xsph_pairs_into(
+        &view,
+        &solver.sorted.vol,
+        list,
+        &kernel,
+        &ap,
+        0.5,
+        &mut shift,
+        &mut both,
+    );
+    let alone: Vec<_> = (0..nf)
+        .map(|i| apd::apd_shift(i, &view, reference.of(i), &kernel, &ap))
+        .collect();
+    assert!(alone.iter().any(|d| d[0] != 0.0));
+    assert_eq!(bits(&shift), bits(&alone));
+    assert_eq!(bits(&both), bits(&expected));
     let mut wall = Vec::new();
     let g = solver.params.gravity;
     adami::wall_pressures_sorted_into(&view, &solver.scratch.cells, &kernel, g, &solver.eos, &mut wall);
