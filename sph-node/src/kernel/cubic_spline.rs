@@ -27,6 +27,13 @@ impl CubicSpline {
         self.h
     }
 
+    /// 1/h: q = r · (1/h) is a multiplication where r/h is a division (issue 20; inlined into a loop, the
+    /// reciprocal is taken once, outside it).
+    #[inline(always)]
+    fn inv_h(&self) -> f64 {
+        1.0 / self.h
+    }
+
     /// Support radius 2h.
     pub fn support(&self) -> f64 {
         2.0 * self.h
@@ -35,7 +42,7 @@ impl CubicSpline {
     /// W(r).
     #[inline]
     pub fn w(&self, r: f64) -> f64 {
-        let q = r / self.h;
+        let q = r * self.inv_h();
         if q < 1.0 {
             self.alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q)
         } else if q < 2.0 {
@@ -49,7 +56,7 @@ impl CubicSpline {
     /// dW/dr (≤ 0).
     #[inline]
     pub fn dw_dr(&self, r: f64) -> f64 {
-        let q = r / self.h;
+        let q = r * self.inv_h();
         let dw_dq = if q < 1.0 {
             self.alpha * (-3.0 * q + 2.25 * q * q)
         } else if q < 2.0 {
@@ -58,14 +65,14 @@ impl CubicSpline {
         } else {
             0.0
         };
-        dw_dq / self.h
+        dw_dq * self.inv_h()
     }
 
     /// (W(r), dW/dr(r)/r) in one evaluation, bit for bit as [`CubicSpline::w`] and [`CubicSpline::dw_dr`]`(r) / r`
     /// (the factor is 0 at r = 0, where [`CubicSpline::grad`] is zero): ∇_i W_ij = factor · r_ij.
     #[inline]
     pub fn w_and_grad_factor(&self, r: f64) -> (f64, f64) {
-        let q = r / self.h;
+        let q = r * self.inv_h();
         let (w, dw_dq) = if q < 1.0 {
             (
                 self.alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q),
@@ -77,7 +84,7 @@ impl CubicSpline {
         } else {
             (0.0, 0.0)
         };
-        let factor = if r > 0.0 { dw_dq / self.h / r } else { 0.0 };
+        let factor = if r > 0.0 { dw_dq * self.inv_h() / r } else { 0.0 };
         (w, factor)
     }
 
@@ -85,11 +92,11 @@ impl CubicSpline {
     /// ([`CubicSpline::w_and_grad_factor`]) at r = √d2 (as [`crate::particles::separation`] gives r), bit for bit
     /// as the scalar function. Branch-free, so that the compiler can evaluate several pairs at once.
     pub fn grad_factors(&self, d2: &[f64], grad: &mut [f64]) {
-        let h = self.h;
+        let inv_h = self.inv_h();
         let alpha = self.alpha;
         for (&d2, g) in d2.iter().zip(grad) {
             let r = d2.sqrt();
-            let q = r / h;
+            let q = r * inv_h;
             let t = 2.0 - q;
             let dq_near = alpha * (-3.0 * q + 2.25 * q * q);
             let dq_far = -0.75 * alpha * t * t;
@@ -100,7 +107,7 @@ impl CubicSpline {
             } else {
                 0.0
             };
-            let f = dq / h / r;
+            let f = dq * inv_h / r;
             *g = if r > 0.0 { f } else { 0.0 };
         }
     }

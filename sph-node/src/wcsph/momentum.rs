@@ -4,8 +4,6 @@
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{dot, ParticleView};
-use crate::wcsph::artificial_viscosity::pi_ij;
-use crate::wcsph::laminar_viscosity::morris_factor;
 
 /// Constants of the momentum equation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,15 +27,16 @@ pub struct Pairs<'a> {
     pub grad: &'a [f64],
 }
 
-/// r² = r · r with r = |r_ij| as [`crate::particles::separation`] computes it.
-#[inline]
-fn r2_of(r_ij: [f64; 2]) -> f64 {
-    let r = (r_ij[0] * r_ij[0] + r_ij[1] * r_ij[1]).sqrt();
-    r * r
-}
-
 /// Dv_i/Dt of fluid particle i over its pairs with their ∇W factors (∇_i W_ij = grad · r_ij, see
 /// [`crate::neighbors::ListChunk`]); `pr2[j]` = p_j/ρ_j².
+///
+/// One loop over the pairs for the pressure, the artificial viscosity (Eq. (11), [`pi_ij`]) and the laminar
+/// viscosity (Eq. (12), [`morris_factor`]), with one division a pair: both viscous terms share the denominator
+/// r_ij² + η², and 1/(ρ̄_ij ρ_j (r_ij² + η²)) serves both (issue 20; before, two loops, two square roots and two
+/// divisions a pair: the same terms up to rounding).
+///
+/// [`pi_ij`]: crate::wcsph::artificial_viscosity::pi_ij
+/// [`morris_factor`]: crate::wcsph::laminar_viscosity::morris_factor
 #[inline]
 pub fn acceleration(
     i: usize,
@@ -49,6 +48,11 @@ pub fn acceleration(
 ) -> [f64; 2] {
     let (xi, vi, rho_i) = (view.x[i], view.v[i], view.rho[i]);
     let pi_term = pr2[i];
+    // Eq. (11): Π_ij = −α c̄ h (v_ij·r_ij) / (ρ̄_ij (r² + η²)), η = 0.1h, for approaching pairs
+    let av = -params.alpha * params.c0 * h;
+    // Eq. (12): m_j (ν_i + ν_j) (r_ij·∇_i W_ij) / (ρ_j (r² + η²)) v_ij, ν_i = ν_j = ν
+    let nu_sum = 2.0 * params.nu;
+    let eta2 = 0.01 * h * h;
     let mut a = [0.0, 0.0];
     for (&j, &g) in pairs.idx.iter().zip(pairs.grad) {
         let j = j as usize;
@@ -56,36 +60,20 @@ pub fn acceleration(
         let r_ij = [xi[0] - xj[0], xi[1] - xj[1]];
         let grad = [g * r_ij[0], g * r_ij[1]];
         let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
-        let rho_j = view.rho[j];
-        let visc = if params.alpha > 0.0 {
-            pi_ij(
-                params.alpha,
-                params.c0,
-                h,
-                dot(v_ij, r_ij),
-                0.5 * (rho_i + rho_j),
-                r2_of(r_ij),
-            )
-        } else {
-            0.0
-        };
+        let (rho_j, m_j) = (view.rho[j], view.m[j]);
+        let rho_bar = 0.5 * (rho_i + rho_j);
+        let r2 = dot(r_ij, r_ij);
+        // 1/(ρ̄_ij ρ_j (r² + η²)): Π_ij takes it times ρ_j, the Morris factor times ρ̄_ij
+        let inv = 1.0 / (rho_bar * rho_j * (r2 + eta2));
+        let vr = dot(v_ij, r_ij);
+        // Evaluated either way and then selected: approaching and separating pairs alternate unpredictably
+        let visc = if vr < 0.0 { av * vr * rho_j * inv } else { 0.0 };
         // Eq. (10), Long et al. 2016
-        let f = view.m[j] * (pi_term + pr2[j] + visc);
-        a[0] -= f * grad[0];
-        a[1] -= f * grad[1];
-    }
-    if params.nu > 0.0 {
-        for (&j, &g) in pairs.idx.iter().zip(pairs.grad) {
-            let j = j as usize;
-            let xj = view.x[j];
-            let r_ij = [xi[0] - xj[0], xi[1] - xj[1]];
-            let grad = [g * r_ij[0], g * r_ij[1]];
-            let v_ij = [vi[0] - view.v[j][0], vi[1] - view.v[j][1]];
-            // Eq. (12), Long et al. 2016, ν_i = ν_j = ν
-            let f = morris_factor(view.m[j], 2.0 * params.nu, dot(r_ij, grad), view.rho[j], r2_of(r_ij), h);
-            a[0] += f * v_ij[0];
-            a[1] += f * v_ij[1];
-        }
+        let f = m_j * (pi_term + pr2[j] + visc);
+        // Eq. (12), Long et al. 2016 (zero at ν = 0)
+        let lam = m_j * nu_sum * dot(r_ij, grad) * rho_bar * inv;
+        a[0] += lam * v_ij[0] - f * grad[0];
+        a[1] += lam * v_ij[1] - f * grad[1];
     }
     // Eq. (10), Long et al. 2016: body force
     [a[0] + params.gravity[0], a[1] + params.gravity[1]]
