@@ -98,7 +98,11 @@ impl FemCore {
         // On a worker of the rayon pool (as sph-node's sub-cycle): the element loop is parallel above
         // `DEFAULT_PARALLEL_MIN_ELEMENTS`, and a parallel loop started from outside the pool hands its work to a
         // worker and sleeps, two context switches a sub-step; the same bits either way.
-        let substeps = if cmd.dt > 0.0 { rayon::scope(|_| self.solver.advance(cmd.dt))? } else { 0 };
+        let substeps = if cmd.dt > 0.0 {
+            rayon::scope(|_| self.solver.advance(cmd.dt))?
+        } else {
+            0
+        };
         let state = self.solver.state();
         let (ids, x, v) = if cmd.want_interface {
             let ids = self.interface_nodes.clone();
