@@ -404,7 +404,13 @@ fn run_spoilt(spoil: &Spoil) -> (RunStatus, String, Option<&'static str>) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, failure_persistence: None, ..ProptestConfig::default() })]
+    // A fixed seed: the same 96 messages every run (CI on a clean clone draws nothing new).
+    #![proptest_config(ProptestConfig {
+        cases: 96,
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x2026_1127),
+        ..ProptestConfig::default()
+    })]
 
     /// The broker's side: every spoilt registration or answer ends the run `failed` (or `unstable` for a NaN or an
     /// infinity in a state) with a message that names the node, the message and the field; none panics or hangs.
