@@ -291,7 +291,6 @@ fn field<'a>(setup: &'a SphSetup, s: &'a SphSnapshot) -> PressureField<'a> {
         rho: &s.rho,
         p: &s.p,
         wall_x: &setup.walls,
-        wall_p: &s.wall_p,
         h: setup.h,
         spacing: setup.spacing,
     }

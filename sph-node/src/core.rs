@@ -302,7 +302,6 @@ fn pressure_field<'a>(solver: &'a dyn FluidSolver, setup: &SphSetup) -> Pressure
         rho: &state.rho,
         p: &state.p,
         wall_x: &walls.x,
-        wall_p: &walls.p,
         h: setup.h,
         spacing: setup.spacing,
     }

@@ -90,7 +90,6 @@ mod tests {
             rho: &rho,
             p: &p,
             wall_x: &walls,
-            wall_p: &[],
             h: 1.3 * dx,
             spacing: dx,
         };

@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::kernel::CubicSpline;
 
-/// The particles a pressure is interpolated from: fluid (positions, masses, densities, pressures) and walls
-/// (positions, extrapolated pressures; their volume is the lattice cell Δx²).
+/// The particles the probes read: fluid (positions, masses, densities, pressures) and wall positions (their volume
+/// is the lattice cell Δx²).
 pub struct PressureField<'a> {
     /// Fluid positions.
     pub x: &'a [[f64; 2]],
@@ -19,34 +19,34 @@ pub struct PressureField<'a> {
     pub rho: &'a [f64],
     /// Fluid pressures.
     pub p: &'a [f64],
-    /// Wall particle positions.
+    /// Wall particle positions (the water-level gauges count them as filled space; pressures leave them out).
     pub wall_x: &'a [[f64; 2]],
-    /// Wall particle pressures.
-    pub wall_p: &'a [f64],
     /// Smoothing length h.
     pub h: f64,
     /// Particle spacing Δx.
     pub spacing: f64,
 }
 
-/// Shepard-normalised SPH interpolation Σ p_j V_j W / Σ V_j W over fluid and wall particles (walls carry their
-/// extrapolated pressure and the lattice volume Δx²); NaN where no particle is within the kernel support.
+/// The fluid's pressure at `point`: the Shepard-normalised SPH interpolation Σ_f p_f V_f W / Σ_f V_f W over the
+/// fluid particles within the kernel's reach (V_f = m_f/ρ_f), as DualSPHysics' gauges interpolate (fluid particles
+/// only, kernel-corrected: `JDsGaugeItem.cpp`, `CODE_IsFluid`); 0, the atmosphere's gauge pressure, where no fluid
+/// particle is in reach (a dry sensor).
+///
+/// Wall particles are left out: their pressures are the boundary condition's device, not the fluid's state (WCSPH:
+/// Adami et al. 2012's extrapolation; ISPH: the unknowns of the walls' Neumann rows, which carry the impulse that
+/// stops the fluid's normal motion). Each wall particle's value is a Shepard mean over the fluid in *its* reach, so one
+/// drop within 2h of a wall gives every wall particle in that reach the drop's full term, whatever their distance
+/// along the wall: at the Lobovsky sensors (ISPH, H/30) a single free-surface particle running ahead of the front
+/// made four wall particles over 4 cm of the wall read 12–15 ρgH for 5 ms, and a probe that took walls in reported
+/// 10.5 ρgH where the fluid's pressure was 0 (docs/CORRECTIONS.md, "What a pressure probe reads").
 pub fn pressure_at(field: &PressureField<'_>, point: [f64; 2]) -> f64 {
     let kernel = CubicSpline::new(field.h);
     let support2 = kernel.support() * kernel.support();
-    let wall_volume = field.spacing * field.spacing;
-    let fluid = field
-        .x
-        .iter()
-        .zip(field.m.iter().zip(field.rho))
-        .zip(field.p)
-        .map(|((x, (m, rho)), p)| (x, m / rho, p));
-    let walls = field.wall_x.iter().zip(field.wall_p).map(|(x, p)| (x, wall_volume, p));
     let (mut num, mut den) = (0.0, 0.0);
-    for (x, volume, p) in fluid.chain(walls) {
+    for ((x, (m, rho)), p) in field.x.iter().zip(field.m.iter().zip(field.rho)).zip(field.p) {
         let r2 = (x[0] - point[0]).powi(2) + (x[1] - point[1]).powi(2);
         if r2 < support2 {
-            let w = kernel.w(r2.sqrt()) * volume;
+            let w = kernel.w(r2.sqrt()) * (m / rho);
             num += p * w;
             den += w;
         }
@@ -54,7 +54,7 @@ pub fn pressure_at(field: &PressureField<'_>, point: [f64; 2]) -> f64 {
     if den > 0.0 {
         num / den
     } else {
-        f64::NAN
+        0.0
     }
 }
 
@@ -174,7 +174,6 @@ mod tests {
                 rho: &rho,
                 p: &p,
                 wall_x: &[],
-                wall_p: &[],
                 h: 1.3 * dx,
                 spacing: dx,
             };
@@ -189,7 +188,6 @@ mod tests {
             rho: &rho,
             p: &p,
             wall_x: &[],
-            wall_p: &[],
             h: 1.3 * dx,
             spacing: dx,
         };
@@ -199,5 +197,48 @@ mod tests {
         assert!(values[0].0 > 900.0 && values[0].0 < 1100.0, "{values:?}");
         // A fresh log: with no step since, the value now (0 here).
         assert_eq!(sensors.take_means(&field), vec![0.0]);
+    }
+
+    /// The probe reads the fluid, not the walls: a lone free-surface drop (p = 0) in reach of five wall particles,
+    /// as at the Lobovsky sensors, reads exactly the drop's pressure; a point with no fluid in reach reads 0 (the
+    /// atmosphere), not NaN; inside a lattice with a linear pressure the Shepard mean is exact.
+    #[test]
+    fn a_pressure_probe_interpolates_the_fluid_only() {
+        let dx = 0.01;
+        let walls: Vec<[f64; 2]> = (0..5).map(|k| [1.615, -0.005 + dx * k as f64]).collect();
+        let drop = [[1.6009, 0.0052]];
+        let (m, rho) = ([0.1], [1000.0]);
+        let probe = |p: f64, point: [f64; 2]| {
+            let p = [p];
+            let field = PressureField {
+                x: &drop,
+                m: &m,
+                rho: &rho,
+                p: &p,
+                wall_x: &walls,
+                h: 1.3 * dx,
+                spacing: dx,
+            };
+            pressure_at(&field, point)
+        };
+        assert_eq!(probe(0.0, [1.605, 0.015]), 0.0);
+        assert_eq!(probe(1234.5, [1.605, 0.015]), 1234.5);
+        // out of the drop's reach (2h = 2.6 cm): dry, 0 — not NaN
+        assert_eq!(probe(1234.5, [1.605, 0.05]), 0.0);
+        // a lattice with p = ρ g (0.2 − y): at a lattice point inside, the Shepard mean of the linear field is exact
+        let x: Vec<[f64; 2]> = (0..400).map(|k| [dx * (k % 20) as f64, dx * (k / 20) as f64]).collect();
+        let p: Vec<f64> = x.iter().map(|x| 9810.0 * (0.2 - x[1])).collect();
+        let (m, rho) = (vec![0.1; x.len()], vec![1000.0; x.len()]);
+        let lattice = PressureField {
+            x: &x,
+            m: &m,
+            rho: &rho,
+            p: &p,
+            wall_x: &[],
+            h: 1.3 * dx,
+            spacing: dx,
+        };
+        let got = pressure_at(&lattice, [0.1, 0.1]);
+        assert!((got - 981.0).abs() <= 1e-9, "{got}");
     }
 }

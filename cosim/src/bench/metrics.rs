@@ -10,6 +10,9 @@
 //!   the first overshoot) against w = q L⁴ / (384 D) = −6.86e-5 m; `error` = |w̄ − w| / |w|.
 //! * Elastic gate (as `cosim/tests/fsi.rs`): the largest horizontal displacement of the free end against the
 //!   published 0.043 m (SPH–FEM and SPH results span 0.039–0.043 m); `error` = |peak − 0.043| / 0.043.
+//! * Wall impact (Lobovsky et al. 2014, as `cosim/tests/lobovsky.rs`; `bench/lobovsky.rs`): per sensor the first
+//!   impact, peak, RMS after the impact, lowest sample and exact zeros; `error` = the larger RMS [ρgH], `value` the
+//!   sensor-1 peak [ρgH] against the recorded 3.04.
 //! * Stress: no error; the fluid's total energy (probe `energy`, 0 at t = 0) against the budget E_b = ρ0 |g| Σ W H²/2
 //!   of the scene's fluid blocks as run (`DIR/scene.toml`): `energy_growth` = max E / E_b (energy the scheme
 //!   created), `energy_drift` = E(end) / E_b (negative: dissipated). Measured whatever the status, up to where the
@@ -19,6 +22,7 @@ use std::path::Path;
 
 use anyhow::{bail, Context};
 
+use super::lobovsky::SensorScore;
 use super::suite::Metric;
 use crate::compare::read_probe;
 
@@ -51,6 +55,8 @@ pub struct Measured {
     pub energy_growth: Option<f64>,
     /// Fluid energy at the end over the budget (stress cases).
     pub energy_drift: Option<f64>,
+    /// The wall-impact sensors' scores (Lobovsky case).
+    pub sensors: Vec<SensorScore>,
 }
 
 /// Measure the run in `out` (scene folder `scenes` for the reference data) at `spacing`.
@@ -80,6 +86,18 @@ pub fn measure(metric: Metric, out: &Path, scenes: &Path, spacing: f64) -> anyho
                 error: Some(((peak - GATE_PEAK) / GATE_PEAK).abs()),
                 value: Some(peak),
                 reference: Some(GATE_PEAK),
+                ..Measured::default()
+            })
+        }
+        Metric::Lobovsky => {
+            // `error`: the worse sensor's RMS difference after the impact [ρgH] (issue 16's bound 0.25); `value`
+            // and `reference`: sensor 1's first-impact peak and the recorded one [ρgH].
+            let sensors = super::lobovsky::score(out, scenes)?;
+            Ok(Measured {
+                error: Some(sensors.iter().map(|s| s.rms).fold(0.0, f64::max)),
+                value: sensors.first().map(|s| s.peak),
+                reference: sensors.first().map(|s| s.peak_data),
+                sensors,
                 ..Measured::default()
             })
         }

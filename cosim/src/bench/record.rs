@@ -5,6 +5,8 @@ use std::path::Path;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
+use super::lobovsky::SensorScore;
+
 /// One bench case's result. A case that failed or blew up is a record too, with `status` and `message`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Record {
@@ -58,6 +60,10 @@ pub struct Record {
     /// Stress cases: the fluid's total energy at the end over its budget (negative: dissipated).
     #[serde(default)]
     pub energy_drift: Option<f64>,
+    /// The wall-impact case: each sensor's first impact, peak, RMS after the impact, lowest sample and exact
+    /// zeros (`bench/lobovsky.rs`); empty for the other cases.
+    #[serde(default)]
+    pub sensors: Vec<SensorScore>,
     /// How `error` is computed.
     pub metric: String,
     /// Peak resident memory of the run's process (VmHWM) [bytes].

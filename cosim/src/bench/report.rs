@@ -45,6 +45,7 @@ pub fn render(ctx: &Context, records: &[Record]) -> String {
     );
     cases_section(&mut md, ctx.cases);
     results_section(&mut md, records);
+    lobovsky_section(&mut md, records);
     stress_section(&mut md, records);
     scaling_section(&mut md, records);
     let failed: Vec<&Record> = records.iter().filter(|r| r.status != "ok").collect();
@@ -120,6 +121,11 @@ fn cases_section(md: &mut String, cases: &[Case]) {
                 Metric::Gate => {
                     " (published SPH–FEM and SPH peaks span 0.039–0.043 m); `error` = |peak − 0.043| / 0.043"
                 }
+                Metric::Lobovsky => {
+                    " on the data's own time axis (t* = t √(g/H), p* = p/(ρgH)); `error` = the larger of the two \
+                     sensors' RMS [ρgH], `value` sensor 1's peak [ρgH]; issue 16's bounds: first impact within \
+                     ±0.1 t*, peak 1.5–6, RMS ≤ 0.25, lowest ≥ −0.5 (table below)"
+                }
                 Metric::Stress => {
                     "; each must end `ok` with every probe sample finite and `energy_growth` ≤ 0.05 (the bound of \
                      `cosim/tests/stress.rs`), or be stopped `unstable` by a guard with a reason"
@@ -172,10 +178,15 @@ fn results_section(md: &mut String, records: &[Record]) {
             r.wall_seconds,
             cpu(r.cpu_seconds),
             r.particle_steps_per_second,
-            r.value.map_or("–".into(), |v| format!("{v:.4e}")),
-            match (r.error, r.error_max) {
-                (Some(e), Some(m)) => format!("{:.2} % (max {:.2} %)", 100.0 * e, 100.0 * m),
-                (Some(e), None) => format!("{:.2} %", 100.0 * e),
+            match (r.value, r.sensors.is_empty()) {
+                (Some(v), true) => format!("{v:.4e}"),
+                (Some(v), false) => format!("{v:.2} ρgH"),
+                (None, _) => "–".into(),
+            },
+            match (r.error, r.error_max, r.sensors.is_empty()) {
+                (Some(e), _, false) => format!("{e:.3} ρgH"),
+                (Some(e), Some(m), true) => format!("{:.2} % (max {:.2} %)", 100.0 * e, 100.0 * m),
+                (Some(e), None, true) => format!("{:.2} %", 100.0 * e),
                 _ => "–".into(),
             },
             mb(r.peak_rss_bytes),
@@ -183,6 +194,46 @@ fn results_section(md: &mut String, records: &[Record]) {
         );
     }
     md.push_str("\nThe same as `pareto.svg`: error against wall time, one curve per case, solver and contact.\n\n");
+}
+
+/// The wall-impact case, per sensor, with issue 16's bounds.
+fn lobovsky_section(md: &mut String, records: &[Record]) {
+    let rows: Vec<&Record> = records.iter().filter(|r| !r.sensors.is_empty()).collect();
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## Wall impact (Lobovsky et al. 2014, H = 0.3 m)\n");
+    let _ = writeln!(
+        md,
+        "Sensor probes (1 ms means), t* = t √(g/H), p* = p/(ρgH); the recording's value in brackets. Issue 16's \
+         bounds: first impact within ±0.1 t*, peak 1.5–6, RMS t* 3–7 ≤ 0.25, lowest ≥ −0.5, and the peak not \
+         growing from H/60 to H/120 by more than from H/30 to H/60.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| solver | Δx [m] | sensor | first impact t* | peak p* | RMS t* 3–7 | lowest p* | exact zeros | wall [s] |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        for s in &r.sensors {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {:.3} ({:.3}) | {:.2} ({:.2}) | {:.3} | {:.2} | {} | {:.1} |",
+                r.solver,
+                r.spacing,
+                s.probe,
+                s.first_impact,
+                s.first_impact_data,
+                s.peak,
+                s.peak_data,
+                s.rms,
+                s.min,
+                s.zeros,
+                r.wall_seconds
+            );
+        }
+    }
+    md.push('\n');
 }
 
 fn stress_section(md: &mut String, records: &[Record]) {

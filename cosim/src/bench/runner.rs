@@ -55,6 +55,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         reference: None,
         energy_growth: None,
         energy_drift: None,
+        sensors: Vec::new(),
         metric: super::suite::describe(case.metric).into(),
         peak_rss_bytes: stats.peak_rss_bytes,
         cpu_seconds: stats.cpu_seconds,
@@ -115,6 +116,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
                 record.error_max = m.error_max;
                 record.value = m.value;
                 record.reference = m.reference;
+                record.sensors = m.sensors;
                 if m.error.is_some_and(|e| !e.is_finite()) {
                     record.status = "failed".into();
                     record.message = "the error is not finite".into();

@@ -15,6 +15,8 @@ pub enum Metric {
     Plate,
     /// Peak horizontal displacement of the free end against the published 0.043 m.
     Gate,
+    /// Wall-impact pressure at sensors 1 and 2 against Lobovsky et al. (2014) (`bench/lobovsky.rs`).
+    Lobovsky,
     /// No error: cost per particle-step only.
     Scaling,
     /// No error: status and the fluid's energy against its budget (stress tests of numerical stability).
@@ -102,7 +104,14 @@ pub struct Selection {
 }
 
 /// The case names, in suite order.
-pub const CASES: [&str; 5] = ["dam_break", "hydrostatic_plate", "elastic_gate", "scaling", "stress"];
+pub const CASES: [&str; 6] = [
+    "dam_break",
+    "hydrostatic_plate",
+    "elastic_gate",
+    "lobovsky_dam_break",
+    "scaling",
+    "stress",
+];
 
 /// Scaling: the dam-break column at these spacings is ~5,000, 20,000, 50,000 and 100,000 particles
 /// (0.1 m × 0.2 m / Δx²).
@@ -192,6 +201,31 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
             add("elastic_gate", solver, contact, gate, gate_end, &[], Metric::Gate);
         }
     }
+    // Wall impact (Lobovsky et al. 2014): H/30 (quick), H/30, H/60 and H/120 (full), the scene's end time t* = 7.15
+    // (the recording's end); the sensor probes follow the spacing, half a spacing in front of the wall.
+    let lobovsky: &[f64] = if q { &[0.01] } else { &[0.01, 0.005, 0.0025] };
+    let lobovsky = if sel.spacings.is_empty() {
+        lobovsky
+    } else {
+        &sel.spacings
+    };
+    for solver in ["wcsph", "isph"] {
+        for &spacing in lobovsky {
+            cases.push(Case {
+                case: "lobovsky_dam_break",
+                variant: "",
+                scene: scenes.join("lobovsky_dam_break.toml"),
+                solver,
+                contact: "none",
+                spacing,
+                end_time: sel.end_time.unwrap_or(LOBOVSKY_END),
+                threads: None,
+                repeats: 1,
+                extra: super::lobovsky::probe_sets(spacing),
+                metric: Metric::Lobovsky,
+            });
+        }
+    }
     for threads in [1, 2] {
         for &spacing in &SCALING_SPACINGS {
             cases.push(Case {
@@ -219,6 +253,9 @@ pub fn suite(scenes: &Path, sel: &Selection) -> Vec<Case> {
     cases
 }
 
+/// End time of the wall-impact case [s]: the scene's, t* = 7.15, where the recording ends.
+const LOBOVSKY_END: f64 = 1.25;
+
 /// Runs of each scaling case (the median is kept).
 const SCALING_REPEATS: usize = 3;
 
@@ -234,6 +271,10 @@ pub fn describe(metric: Metric) -> &'static str {
         Metric::DamBreak => "surge front (probe `surge_front` + Δx/2, so Z(0) = 1) against Martin & Moyce 1952, n² = 2",
         Metric::Plate => "mean mid-span deflection (probe `mid_uy`) over 0.05 s < t ≤ end against −6.86e-5 m",
         Metric::Gate => "peak horizontal displacement of the free end (probe `tip_x`) against 0.043 m",
+        Metric::Lobovsky => {
+            "pressure at sensors 1 and 2 (probes `p_sensor1`, `p_sensor2`, 1 ms means) against Lobovsky et al. 2014's \
+             peak event: first impact, peak, RMS for t* in [3, 7], lowest sample, exact zeros"
+        }
         Metric::Scaling => "no error: fluid cost per particle-step",
         Metric::Stress => {
             "no error: status, and the fluid's energy (probe `energy`) against its budget E_b = ρ0 g Σ W H²/2"
