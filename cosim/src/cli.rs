@@ -204,8 +204,8 @@ pub struct BenchArgs {
     /// Output folder: bench.json, report.md, pareto.svg, and each case's run under runs/.
     #[arg(long)]
     pub out: PathBuf,
-    /// Run only these cases (dam_break, hydrostatic_plate, elastic_gate, scaling, stress; repeatable or
-    /// comma-separated).
+    /// Run only these cases (dam_break, hydrostatic_plate, elastic_gate, lobovsky_dam_break, scaling, stress;
+    /// repeatable or comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
     /// Run only these fluid solvers (wcsph, isph).
