@@ -45,7 +45,8 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         .min(if coupled { dt_fluid } else { f64::INFINITY });
     let steps = (s.run.end_time / dt).ceil() as u64;
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
-    let frames = (s.run.end_time / s.run.output_interval).ceil() as u64 + 1;
+    let samples = (s.run.end_time / s.run.output_interval).ceil() as u64 + 1;
+    let frames = s.run.frame_count();
     if args.json {
         let doc = serde_json::json!({
             "scene": args.scene.display().to_string(),
@@ -62,6 +63,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
             "frames": frames,
+            "samples": samples,
             "probes": s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
             // From the scene alone (proto::sizing): what `run` compares with the memory available.
             "estimate": {
@@ -91,8 +93,11 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     }
     println!("scene {} ({}): valid", args.scene.display(), s.run.name);
     println!(
-        "  run: end_time {} s, output every {} s ({} frames), gravity {:?}",
-        s.run.end_time, s.run.output_interval, frames, s.run.gravity
+        "  run: end_time {} s, output every {} s ({samples} probe samples, {frames} frames{}), gravity {:?}",
+        s.run.end_time,
+        s.run.output_interval,
+        s.run.frame_interval.map_or(String::new(), |f| format!(" every {f} s")),
+        s.run.gravity
     );
     for solid in &s.solids {
         let [nx, ny] = solid.grid_size();

@@ -231,6 +231,79 @@ fn isph_restart_is_byte_identical() {
     assert!(probes(&whole) == probes(&continued), "ISPH restart: probes.csv differs");
 }
 
+/// `run.frame_interval`: frames at every third output time of the coarse gate (0.015 s; probes every 0.005 s) and at
+/// the last one, named by their output time's number, listed in the `.pvd`s; a restart from the 0.04 s checkpoint (not
+/// on a frame time) into a fresh folder writes the frames from there on, probes.csv and the plots byte for byte.
+#[test]
+fn frames_at_their_own_interval_and_across_a_restart() {
+    let dir = scratch("checkpoint-frames");
+    let (whole, continued) = (dir.join("whole"), dir.join("continued"));
+    let gate = scene("elastic_gate.toml");
+    let base = [
+        "run",
+        &gate,
+        "--quiet",
+        "--in-process",
+        "--set",
+        "fluid.spacing=0.006",
+        "--set",
+        "run.end_time=0.1",
+        "--set",
+        "run.frame_interval=0.015",
+    ];
+    let whole_s = whole.display().to_string();
+    run_ok(&[&base[..], &["--out", &whole_s, "--checkpoint-interval", "0.04"]].concat());
+    let summary = json(&whole.join("summary.json"));
+    // 21 output times, k = 0 … 20: frames at k = 0, 3, …, 18 and at the last, 20.
+    assert_eq!(summary["samples"].as_u64(), Some(21));
+    assert_eq!(summary["frames"].as_u64(), Some(8));
+    let names = |d: &Path, prefix: &str| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d.join("frames"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(prefix) && n.ends_with(".vtu"))
+            .collect();
+        v.sort();
+        v
+    };
+    let want: Vec<String> = [0, 3, 6, 9, 12, 15, 18, 20]
+        .iter()
+        .map(|k| format!("particles_{k:05}.vtu"))
+        .collect();
+    assert_eq!(names(&whole, "particles_"), want);
+    assert_eq!(names(&whole, "structure_").len(), 8);
+    let pvd = std::fs::read_to_string(whole.join("frames/particles.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 8);
+    assert!(
+        pvd.contains("particles_00020.vtu") && !pvd.contains("particles_00001.vtu"),
+        "{pvd}"
+    );
+    let rows = std::fs::read_to_string(whole.join("probes.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(rows, 22, "a header and 21 probe rows");
+
+    let first = checkpoints(&whole).remove(0).1;
+    assert_eq!(json(&first.join("checkpoint.json"))["t"].as_f64(), Some(0.04));
+    let (first_s, continued_s) = (first.display().to_string(), continued.display().to_string());
+    run_ok(&[&base[..], &["--out", &continued_s, "--restart", &first_s]].concat());
+    // A fresh folder: the frames from the checkpoint's time on (k = 8 was sampled before it), each the same bytes;
+    // probes.csv and the plots whole (the checkpoint carries the rows before).
+    assert_eq!(names(&continued, "particles_"), &want[3..]);
+    let a = tree(&whole);
+    let b = tree(&continued);
+    assert!(b.iter().any(|f| f.0 == "probes.csv"));
+    for (name, y) in &b {
+        if name.ends_with(".pvd") {
+            continue;
+        }
+        let x = a.iter().find(|f| &f.0 == name).map(|f| &f.1);
+        assert!(x == Some(y), "{name} differs after the restart");
+    }
+}
+
 /// A copy of the checkpoint folder `ck` at `to`; returns `to`.
 fn copy_of(ck: &Path, to: &Path) -> PathBuf {
     std::fs::create_dir_all(to).unwrap();

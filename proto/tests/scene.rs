@@ -139,3 +139,27 @@ fn fluid_cfl_defaults_to_one_and_is_refused_above_one() {
         assert_eq!(e.lines().count(), 1, "{e}");
     }
 }
+
+#[test]
+fn frame_interval_is_a_whole_multiple_of_the_output_interval() {
+    let s = parse("f.toml", SCENE, &[]).unwrap();
+    assert_eq!(
+        (s.run.frame_interval, s.run.frame_every(), s.run.frame_count()),
+        (None, 1, 11)
+    );
+    // Absent, the resolved scene is written as before (checkpoints compare it line by line).
+    assert!(!s.to_toml().contains("frame_interval"));
+    let s = parse("f.toml", SCENE, &["run.frame_interval=0.3".into()]).unwrap();
+    // 10 output times after t = 0: frames at 0, 3, 6, 9 and the last, 10.
+    assert_eq!((s.run.frame_every(), s.run.frame_count()), (3, 5));
+    assert!(s.run.is_frame(9, false) && !s.run.is_frame(10, false) && s.run.is_frame(10, true));
+    assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    let s = parse("f.toml", SCENE, &["run.frame_interval=0.5".into()]).unwrap();
+    assert_eq!(s.run.frame_count(), 3);
+    for bad in ["0.25", "0.05", "0", "-0.1", "nan"] {
+        let e = err(SCENE, &[&format!("run.frame_interval={bad}")]);
+        assert!(e.starts_with("f.toml: run.frame_interval: "), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    assert!(err(SCENE, &["run.frame_interval=0.25"]).contains("not a whole multiple of run.output_interval (0.1 s)"));
+}

@@ -149,6 +149,7 @@ fn drive(
             let mut round = exchange::exchange(nodes, &interface_ids, summary, 0, 0.0, commands)?;
             outputs.sample(
                 0.0,
+                false,
                 &mut round,
                 nodes,
                 contact.load.as_deref(),
@@ -171,6 +172,7 @@ fn drive(
             if step.lands {
                 outputs.sample(
                     clock.t,
+                    !clock.running(),
                     &mut round,
                     nodes,
                     contact.load.as_deref(),

@@ -26,6 +26,7 @@ pub(super) struct Outputs<'s> {
     pub probes: Probes,
     pub csv: ProbeCsv,
     frames: FrameQueue,
+    scene: cosim_proto::scene::RunSpec,
     series: &'s mut Series,
     mesh: Option<Arc<FemMesh>>,
     walls: Option<Arc<Vec<[f64; 2]>>>,
@@ -62,6 +63,7 @@ impl<'s> Outputs<'s> {
             probes,
             csv,
             frames,
+            scene: scene.scene.run.clone(),
             series,
             mesh,
             walls,
@@ -79,10 +81,13 @@ impl<'s> Outputs<'s> {
         Ok(())
     }
 
-    /// Sample the probes and write the frames of an output time, from the snapshots of `round`.
+    /// Sample the probes and write the frames of an output time, from the snapshots of `round`: frames at every
+    /// `run.frame_interval` (and at `last`, the run's last output time), named by the output time's number.
+    #[allow(clippy::too_many_arguments)]
     pub fn sample(
         &mut self,
         t: f64,
+        last: bool,
         round: &mut Round,
         nodes: &Nodes<'_>,
         load: Option<&[[f64; 2]]>,
@@ -103,7 +108,12 @@ impl<'s> Outputs<'s> {
         *since = LoadLog::default();
         self.csv.push(t, &values)?;
         self.push_series(t, &values);
-        let index = summary.frames as usize;
+        let index = summary.samples as usize;
+        summary.samples += 1;
+        if !self.scene.is_frame(index as u64, last) {
+            summary.timings.broker += started.elapsed().as_secs_f64();
+            return Ok(());
+        }
         if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
             let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
             self.frames.push(Box::new(move |w| {
@@ -116,7 +126,6 @@ impl<'s> Outputs<'s> {
                 .push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
         }
         summary.frames += 1;
-        summary.samples += 1;
         summary.timings.broker += started.elapsed().as_secs_f64();
         Ok(())
     }

@@ -173,6 +173,21 @@ impl Scene {
         )?;
         finite_positive("run.end_time", self.run.end_time)?;
         finite_positive("run.output_interval", self.run.output_interval)?;
+        if let Some(f) = self.run.frame_interval {
+            finite_positive("run.frame_interval", f)?;
+            let ratio = f / self.run.output_interval;
+            check(
+                ratio >= 1.0 - 1e-9 && (ratio - ratio.round()).abs() <= 1e-9 * ratio,
+                || "run.frame_interval".into(),
+                || {
+                    format!(
+                        "{f} s is not a whole multiple of run.output_interval ({} s): frames are written at output \
+                         times",
+                        self.run.output_interval
+                    )
+                },
+            )?;
+        }
         check(
             self.run.gravity.iter().all(|g| g.is_finite()),
             || "run.gravity".into(),

@@ -57,8 +57,33 @@ pub struct RunSpec {
     /// Gravity [m/s²].
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 2],
-    /// Interval between frames and probe samples \[s\].
+    /// Interval between probe samples (and frames, unless `frame_interval` says otherwise) \[s\].
     pub output_interval: f64,
+    /// Interval between frames \[s\]: a whole multiple of `output_interval` (default: every output time). The first
+    /// and the last output times always get a frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_interval: Option<f64>,
+}
+
+impl RunSpec {
+    /// Frames are written at every `frame_every`-th output time (the first and the last always): the
+    /// `frame_interval` in output intervals, 1 without one. Validation has made it a whole positive multiple.
+    pub fn frame_every(&self) -> u64 {
+        self.frame_interval
+            .map_or(1, |f| (f / self.output_interval).round().max(1.0) as u64)
+    }
+
+    /// Whether output time number `k` (0 at t = 0) gets a frame; `last`: it is the run's last output time.
+    pub fn is_frame(&self, k: u64, last: bool) -> bool {
+        last || k % self.frame_every() == 0
+    }
+
+    /// Frames a run to `end_time` writes: output times 0, `frame_every`, 2 `frame_every`, … and the last one.
+    pub fn frame_count(&self) -> u64 {
+        let samples = (self.end_time / self.output_interval).ceil() as u64;
+        let every = self.frame_every();
+        samples / every + 1 + u64::from(samples % every != 0)
+    }
 }
 
 fn default_gravity() -> [f64; 2] {
