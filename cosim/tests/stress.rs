@@ -541,7 +541,13 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
 /// 2026-11-27 (night), at 1e-4, frames every step around the first large gain: at t = 0.1019 s nine particles along
 /// the deflected gate's underside (the top layer of the jet under it, x = 0.126–0.147 m, y = 3–26 mm), all free
 /// surface (p = 0) the step before, carry 30–68 kPa and gain 0.165 J/m (+0.017 of the budget) in one step; the
-/// next three steps add +0.024. Not analysed further (which rows they became, the face velocity they saw).
+/// next three steps add +0.024. Instrumented (not committed): in that step the contact face of the particles under
+/// the tip jumps from the tip's underside (n = (−0.13, −0.99)) to the plane of the gate's upstream face (n = (−0.74,
+/// −0.67)), inherited from a neighbour (`isph::contact::contact_rows_into` takes the first neighbour's face that cuts
+/// the support); the jet flowing under the tip at (1.1, 0.2) m/s then "approaches" that plane at 0.95 m/s, the PPE
+/// source stops it (ρ u Δx/Δt ≈ 38 kPa) and the whole jet under the gate goes from clipped suction (p = 0) to 35–68
+/// kPa. Choosing the candidate face the particle is furthest in front of (the separating plane of a convex corner)
+/// instead: +0.068 (from +0.071 in that run, output every 2 ms), the kicks at other times remain.
 #[test]
 #[ignore = "found by this test: the coupled ISPH gate gains 7.4 % (max_dt 1e-4, 2026-11-27 night; 6.2 % before the \
             last-bit arithmetic of the speed work, 24 % before the ISPH walls acted on contact only, 10 % before their \
