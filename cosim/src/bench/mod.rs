@@ -125,8 +125,15 @@ fn progress_line(r: &record::Record) -> String {
         "{}{variant} {}{contact}{threads} dx={}: {}, {} particles, {} steps, {:.2} s, {:.2e} particle-steps/s",
         r.case, r.solver, r.spacing, r.status, r.particles, r.steps, r.wall_seconds, r.particle_steps_per_second
     );
-    if let Some(e) = r.error {
-        line += &format!(", error {:.2} %", 100.0 * e);
+    match (r.error, r.sensors.as_slice()) {
+        (Some(_), [s1, s2, ..]) => {
+            line += &format!(
+                ", first impact t* {:.3} / {:.3}, peak {:.2} / {:.2} ρgH, RMS {:.3} / {:.3} ρgH",
+                s1.first_impact, s2.first_impact, s1.peak, s2.peak, s1.rms, s2.rms
+            )
+        }
+        (Some(e), _) => line += &format!(", error {:.2} %", 100.0 * e),
+        (None, _) => {}
     }
     if let (Some(g), Some(d)) = (r.energy_growth, r.energy_drift) {
         line += &format!(", energy max {g:+.4} end {d:+.4} of the budget");
