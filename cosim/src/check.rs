@@ -45,7 +45,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         .min(if coupled { dt_fluid } else { f64::INFINITY });
     let steps = (s.run.end_time / dt).ceil() as u64;
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
-    let samples = (s.run.end_time / s.run.output_interval).ceil() as u64 + 1;
+    let samples = s.run.sample_count();
     let frames = s.run.frame_count();
     if args.json {
         let doc = serde_json::json!({

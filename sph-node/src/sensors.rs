@@ -146,14 +146,46 @@ impl IntervalSensors {
 mod tests {
     use super::*;
 
+    /// Particle spacing of the test lattices [m].
+    const DX: f64 = 0.01;
+
+    /// A 20 × 20 lattice of fluid particles Δx apart (0.1 kg/m, ρ = 1000), no walls.
+    struct Lattice {
+        x: Vec<[f64; 2]>,
+        m: Vec<f64>,
+        rho: Vec<f64>,
+    }
+
+    impl Lattice {
+        fn new() -> Self {
+            let x: Vec<[f64; 2]> = (0..400).map(|k| [DX * (k % 20) as f64, DX * (k / 20) as f64]).collect();
+            let n = x.len();
+            Self {
+                x,
+                m: vec![0.1; n],
+                rho: vec![1000.0; n],
+            }
+        }
+
+        /// The lattice carrying pressures `p`, read with h = 1.3 Δx.
+        fn field<'a>(&'a self, p: &'a [f64]) -> PressureField<'a> {
+            PressureField {
+                x: &self.x,
+                m: &self.m,
+                rho: &self.rho,
+                p,
+                wall_x: &[],
+                h: 1.3 * DX,
+                spacing: DX,
+            }
+        }
+    }
+
     /// A still column's hydrostatic pressure p = ρ g (H − y) on a lattice: a sensor's interval mean over steps of
     /// different lengths is the time-weighted mean of its per-step values.
     #[test]
     fn the_interval_mean_weights_each_step_by_its_length() {
-        let dx = 0.01;
-        let x: Vec<[f64; 2]> = (0..400).map(|k| [dx * (k % 20) as f64, dx * (k / 20) as f64]).collect();
-        let n = x.len();
-        let (m, rho) = (vec![0.1; n], vec![1000.0; n]);
+        let lattice = Lattice::new();
         let sensor = PressureSensor {
             probe: 0,
             points: vec![[0.1, 0.1]],
@@ -167,30 +199,14 @@ mod tests {
         };
         let mut values = Vec::new();
         for (scale, dt) in [(1.0, 1e-3), (3.0, 2e-3), (0.5, 5e-4)] {
-            let p: Vec<f64> = x.iter().map(|x| scale * 9810.0 * (0.2 - x[1])).collect();
-            let field = PressureField {
-                x: &x,
-                m: &m,
-                rho: &rho,
-                p: &p,
-                wall_x: &[],
-                h: 1.3 * dx,
-                spacing: dx,
-            };
+            let p: Vec<f64> = lattice.x.iter().map(|x| scale * 9810.0 * (0.2 - x[1])).collect();
+            let field = lattice.field(&p);
             values.push((sensor_pressure(&field, &sensor), dt));
             sensors.after_step(&field, dt);
         }
         let want = values.iter().map(|(v, dt)| v * dt).sum::<f64>() / 3.5e-3;
-        let p: Vec<f64> = vec![0.0; n];
-        let field = PressureField {
-            x: &x,
-            m: &m,
-            rho: &rho,
-            p: &p,
-            wall_x: &[],
-            h: 1.3 * dx,
-            spacing: dx,
-        };
+        let p: Vec<f64> = vec![0.0; lattice.x.len()];
+        let field = lattice.field(&p);
         let got = sensors.take_means(&field);
         assert!((got[0] - want).abs() <= 1e-12 * want.abs(), "{got:?} vs {want}");
         // The point value of the middle step is ~3× the hydrostatic 981 Pa: the mean sits between, weighted.
@@ -204,8 +220,7 @@ mod tests {
     /// atmosphere), not NaN; inside a lattice with a linear pressure the Shepard mean is exact.
     #[test]
     fn a_pressure_probe_interpolates_the_fluid_only() {
-        let dx = 0.01;
-        let walls: Vec<[f64; 2]> = (0..5).map(|k| [1.615, -0.005 + dx * k as f64]).collect();
+        let walls: Vec<[f64; 2]> = (0..5).map(|k| [1.615, -0.005 + DX * k as f64]).collect();
         let drop = [[1.6009, 0.0052]];
         let (m, rho) = ([0.1], [1000.0]);
         let probe = |p: f64, point: [f64; 2]| {
@@ -216,8 +231,8 @@ mod tests {
                 rho: &rho,
                 p: &p,
                 wall_x: &walls,
-                h: 1.3 * dx,
-                spacing: dx,
+                h: 1.3 * DX,
+                spacing: DX,
             };
             pressure_at(&field, point)
         };
@@ -226,19 +241,9 @@ mod tests {
         // out of the drop's reach (2h = 2.6 cm): dry, 0 — not NaN
         assert_eq!(probe(1234.5, [1.605, 0.05]), 0.0);
         // a lattice with p = ρ g (0.2 − y): at a lattice point inside, the Shepard mean of the linear field is exact
-        let x: Vec<[f64; 2]> = (0..400).map(|k| [dx * (k % 20) as f64, dx * (k / 20) as f64]).collect();
-        let p: Vec<f64> = x.iter().map(|x| 9810.0 * (0.2 - x[1])).collect();
-        let (m, rho) = (vec![0.1; x.len()], vec![1000.0; x.len()]);
-        let lattice = PressureField {
-            x: &x,
-            m: &m,
-            rho: &rho,
-            p: &p,
-            wall_x: &[],
-            h: 1.3 * dx,
-            spacing: dx,
-        };
-        let got = pressure_at(&lattice, [0.1, 0.1]);
+        let lattice = Lattice::new();
+        let p: Vec<f64> = lattice.x.iter().map(|x| 9810.0 * (0.2 - x[1])).collect();
+        let got = pressure_at(&lattice.field(&p), [0.1, 0.1]);
         assert!((got - 981.0).abs() <= 1e-9, "{got}");
     }
 }

@@ -26,7 +26,8 @@ pub(super) struct Outputs<'s> {
     pub probes: Probes,
     pub csv: ProbeCsv,
     frames: FrameQueue,
-    scene: cosim_proto::scene::RunSpec,
+    /// `[run]`: which output times get frames.
+    run: cosim_proto::scene::RunSpec,
     series: &'s mut Series,
     mesh: Option<Arc<FemMesh>>,
     walls: Option<Arc<Vec<[f64; 2]>>>,
@@ -63,7 +64,7 @@ impl<'s> Outputs<'s> {
             probes,
             csv,
             frames,
-            scene: scene.scene.run.clone(),
+            run: scene.scene.run.clone(),
             series,
             mesh,
             walls,
@@ -110,22 +111,20 @@ impl<'s> Outputs<'s> {
         self.push_series(t, &values);
         let index = summary.samples as usize;
         summary.samples += 1;
-        if !self.scene.is_frame(index as u64, last) {
-            summary.timings.broker += started.elapsed().as_secs_f64();
-            return Ok(());
+        if self.run.is_frame(index as u64, last) {
+            if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
+                let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
+                self.frames.push(Box::new(move |w| {
+                    w.write_structure(index, t, &mesh, &snap, load.as_deref()).map(drop)
+                }))?;
+            }
+            if let (Some(walls), Some(snap)) = (&self.walls, round.sph.as_mut().and_then(|s| s.snapshot.take())) {
+                let (walls, density) = (Arc::clone(walls), self.density);
+                self.frames
+                    .push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
+            }
+            summary.frames += 1;
         }
-        if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
-            let (mesh, load) = (Arc::clone(mesh), load.map(<[_]>::to_vec));
-            self.frames.push(Box::new(move |w| {
-                w.write_structure(index, t, &mesh, &snap, load.as_deref()).map(drop)
-            }))?;
-        }
-        if let (Some(walls), Some(snap)) = (&self.walls, round.sph.as_mut().and_then(|s| s.snapshot.take())) {
-            let (walls, density) = (Arc::clone(walls), self.density);
-            self.frames
-                .push(Box::new(move |w| write_particles(w, index, t, &walls, density, &snap)))?;
-        }
-        summary.frames += 1;
         summary.timings.broker += started.elapsed().as_secs_f64();
         Ok(())
     }

@@ -15,6 +15,7 @@ use std::path::Path;
 use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
 
+use super::metrics::{curve, interpolate};
 use crate::compare::read_probe;
 
 /// Water column height H [m], gravity [m/s²] and density [kg/m³] of the experiment.
@@ -71,7 +72,11 @@ pub fn score(out: &Path, scenes: &Path) -> anyhow::Result<Vec<SensorScore>> {
                 .map(|(t, p)| (t / ts, p / ps))
                 .collect();
             let file = scenes.join(format!("data/lobovsky2014_H300_sensor{k}_event.csv"));
-            let data = read_data(&file)?;
+            // (t*, p*): the recording's two columns, `t_star`, `p_star`
+            let data = curve(&file)?;
+            if data.len() < 2 {
+                bail!("{}: fewer than two rows", file.display());
+            }
             let t1 = first_impact(&sim).with_context(|| format!("{probe}: no impact (p* never reaches {IMPACT})"))?;
             let t1_data = first_impact(&data).with_context(|| format!("{}: no impact", file.display()))?;
             let peak = sim
@@ -82,7 +87,7 @@ pub fn score(out: &Path, scenes: &Path) -> anyhow::Result<Vec<SensorScore>> {
             let diffs: Vec<f64> = sim
                 .iter()
                 .filter(|p| (AFTER.0..=AFTER.1).contains(&p.0))
-                .map(|p| p.1 - at(&data, p.0))
+                .map(|p| p.1 - interpolate(&data, p.0))
                 .collect();
             if diffs.is_empty() {
                 bail!("{probe}: no sample in t* {AFTER:?}");
@@ -101,47 +106,8 @@ pub fn score(out: &Path, scenes: &Path) -> anyhow::Result<Vec<SensorScore>> {
         .collect()
 }
 
-/// (t*, p*) of a recording (columns `t_star`, `p_star`).
-fn read_data(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').map(str::trim).collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .with_context(|| format!("{}: no column {name}", path.display()))
-    };
-    let (ct, cp) = (col("t_star")?, col("p_star")?);
-    let rows = lines
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| {
-            let f: Vec<&str> = l.split(',').collect();
-            let num = |c: usize| {
-                f.get(c)
-                    .and_then(|s| s.trim().parse::<f64>().ok())
-                    .with_context(|| format!("{}: line {}: not a number", path.display(), i + 2))
-            };
-            Ok((num(ct)?, num(cp)?))
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    if rows.len() < 2 {
-        bail!("{}: fewer than two rows", path.display());
-    }
-    Ok(rows)
-}
-
 fn first_impact(s: &[(f64, f64)]) -> Option<f64> {
     s.iter().find(|p| p.0 > 1.0 && p.1 >= IMPACT).map(|p| p.0)
-}
-
-/// Linear interpolation of `s` (sorted by t, at least two points) at `t`, held constant beyond its ends.
-fn at(s: &[(f64, f64)], t: f64) -> f64 {
-    let k = s.partition_point(|p| p.0 <= t).clamp(1, s.len() - 1);
-    let ((t0, p0), (t1, p1)) = (s[k - 1], s[k]);
-    let u = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-    p0 + (p1 - p0) * u
 }
 
 #[cfg(test)]
@@ -185,7 +151,7 @@ mod tests {
         let rows: String = (0..=1250)
             .map(|k| {
                 let t = 0.001 * k as f64;
-                let p = at(&data, t / ts) * ps;
+                let p = interpolate(&data, t / ts) * ps;
                 format!("{t},{p},{p}\n")
             })
             .collect();

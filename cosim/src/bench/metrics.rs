@@ -174,7 +174,7 @@ fn dam_break(out: &Path, scenes: &Path, spacing: f64) -> anyhow::Result<Measured
 }
 
 /// (x, y) rows of a two-column CSV with a header.
-fn curve(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
+pub(super) fn curve(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
     Ok(text
         .lines()
@@ -187,7 +187,7 @@ fn curve(path: &Path) -> anyhow::Result<Vec<(f64, f64)>> {
 }
 
 /// Linear interpolation of y(x) on a curve sorted by x (extrapolated from the end segments).
-fn interpolate(curve: &[(f64, f64)], x: f64) -> f64 {
+pub(super) fn interpolate(curve: &[(f64, f64)], x: f64) -> f64 {
     let k = curve.partition_point(|p| p.0 < x).clamp(1, curve.len() - 1);
     let (a, b) = (curve[k - 1], curve[k]);
     a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)

@@ -78,11 +78,16 @@ impl RunSpec {
         last || k % self.frame_every() == 0
     }
 
+    /// Output times (probe samples) of a run to `end_time`, t = 0 and the end included.
+    pub fn sample_count(&self) -> u64 {
+        ((self.end_time / self.output_interval).ceil() as u64).saturating_add(1)
+    }
+
     /// Frames a run to `end_time` writes: output times 0, `frame_every`, 2 `frame_every`, … and the last one.
     pub fn frame_count(&self) -> u64 {
-        let samples = (self.end_time / self.output_interval).ceil() as u64;
+        let last = self.sample_count() - 1;
         let every = self.frame_every();
-        samples / every + 1 + u64::from(samples % every != 0)
+        last / every + 1 + u64::from(last % every != 0)
     }
 }
 
