@@ -48,6 +48,11 @@ pub trait FluidSolver: Send + Sync {
         None
     }
 
+    /// Iterations of the last step's pressure solve, where the method solves one (ISPH); `None` otherwise.
+    fn ppe_iterations(&self) -> Option<usize> {
+        None
+    }
+
     /// The solver's state between two steps, for a checkpoint.
     fn save(&self) -> SavedSolver;
 

@@ -160,6 +160,39 @@ impl SparseRows {
         }
     }
 
+    /// Multiplies row i and `b[i]` by `s[i]` (the Jacobi scaling s = 1/A_ii of [`super::bicgstab`]).
+    pub fn scale_rows(&mut self, s: &[f64], b: &mut [f64]) {
+        self.chunks
+            .par_iter_mut()
+            .zip(s.par_chunks(ROWS).zip(b.par_chunks_mut(ROWS)))
+            .for_each(|(c, (s, b))| {
+                for (k, (s, b)) in s.iter().zip(b.iter_mut()).enumerate() {
+                    *b *= s;
+                    for v in &mut c.val[c.start[k] as usize..c.start[k + 1] as usize] {
+                        *v *= s;
+                    }
+                }
+            });
+    }
+
+    /// r = f − A x (a gather per row, each in its stored order).
+    pub fn residual_into(&self, f: &[f64], x: &[f64], r: &mut [f64]) {
+        r.par_chunks_mut(ROWS)
+            .zip(f.par_chunks(ROWS))
+            .zip(&self.chunks)
+            .for_each(|((r, f), c)| {
+                for (k, (ri, fi)) in r.iter_mut().zip(f).enumerate() {
+                    let range = c.start[k] as usize..c.start[k + 1] as usize;
+                    *ri = fi
+                        - c.col[range.clone()]
+                            .iter()
+                            .zip(&c.val[range])
+                            .map(|(&c, &v)| v * x[c as usize])
+                            .sum::<f64>();
+                }
+            });
+    }
+
     /// y = A x (a gather per row).
     pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(ROWS).zip(&self.chunks).for_each(|(y, c)| {

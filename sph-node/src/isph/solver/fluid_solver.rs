@@ -41,6 +41,10 @@ impl FluidSolver for IsphSolver {
         IsphSolver::step(self, dt)
     }
 
+    fn ppe_iterations(&self) -> Option<usize> {
+        Some(self.last_ppe().iterations)
+    }
+
     fn save(&self) -> SavedSolver {
         self.save_state()
     }
