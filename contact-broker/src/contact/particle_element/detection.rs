@@ -88,12 +88,36 @@ pub(crate) struct Detector<'a> {
     /// The largest gap g any caller acts on (the touch gap of the velocity phase; `f64::INFINITY` for every
     /// contact): [`Detector::detect`] may answer `None` for a master whose gap is certainly above it.
     pub reach: f64,
+    /// The frame of every segment at `x` (`Frame::new` of its nodes, `None` for a collapsed one), when the caller
+    /// computed them once for nodes that do not move; `None`: computed at each use.
+    pub frames: Option<&'a [Option<Frame>]>,
 }
 
 impl Detector<'_> {
     fn frame(&self, j: u32) -> Option<Frame> {
+        if let Some(frames) = self.frames {
+            return frames[j as usize];
+        }
         let s = self.segments[j as usize];
         Frame::new(self.x[s.a], self.x[s.b], self.min_len)
+    }
+
+    /// Fills `out` with the frame of every segment at these node positions (what [`Detector::frames`] holds).
+    pub fn frames_into(&self, out: &mut Vec<Option<Frame>>) {
+        out.clear();
+        out.extend(
+            self.segments
+                .iter()
+                .map(|s| Frame::new(self.x[s.a], self.x[s.b], self.min_len)),
+        );
+    }
+
+    /// Whether node `k` may act as a master at these node positions: `false` at a concave or straight corner,
+    /// where [`Detector::detect`] finds no contact wherever the particle is (its corner test, which depends on the
+    /// nodes only).
+    pub fn node_may_act(&self, k: usize) -> bool {
+        let (p, q) = (self.topo.prev[k], self.topo.next[k]);
+        !(p != NONE && q != NONE && cross(self.delta(p), self.delta(q)) <= 0.0)
     }
 
     /// Whether the master cannot move (all its nodes fixed: infinite mass, 1/m = 0).
@@ -122,12 +146,17 @@ impl Detector<'_> {
                 let s = self.segments[j as usize];
                 let x1 = self.x[s.a];
                 let d = sub(self.x[s.b], x1);
-                if !(0.0..=1.0).contains(&xi(x1, d, xs)) {
+                // (x_s − x_c)·n · L = (x_s − x1) × d, n = (t_y, −t_x) (`Frame`): beyond `far` on the fluid side, or
+                // beyond the far-side limit plus r_c (a margin as far above round-off as `far`'s) behind the
+                // segment, where `attach` finds the particle outside (dn ≤ −d_max). Tested before ξ: no division,
+                // and most masters gathered near a particle are rejected here (the far face of a thin structure).
+                let dn_len = cross(sub(xs, x1), d);
+                let back = self.far_side + self.thickness;
+                let reach2 = if dn_len > 0.0 { far * far } else { back * back };
+                if dn_len * dn_len > reach2 * dot(d, d) {
                     return None;
                 }
-                // (x_s − x_c)·n · L = (x_s − x1) × d, n = (t_y, −t_x) (`Frame`): beyond `far` on the fluid side.
-                let dn_len = cross(sub(xs, x1), d);
-                if dn_len > 0.0 && dn_len * dn_len > far * far * dot(d, d) {
+                if !(0.0..=1.0).contains(&xi(x1, d, xs)) {
                     return None;
                 }
             }
@@ -272,6 +301,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         // Below the bottom edge (fluid side), 0.05 away: penetrates the 0.1 thickness by 0.05.
         let h = det.detect(Master::Segment(0), [0.25, -0.05]).unwrap();
@@ -303,7 +333,7 @@ mod tests {
             let mut topo = Topology::default();
             topo.build(4, &s);
             let full = Detector { x: &x, segments: &s, topo: &topo, thickness: 0.1, far_side: 0.3, min_len: 0.0,
-                reach: f64::INFINITY };
+                reach: f64::INFINITY, frames: None };
             let near = Detector { reach, ..full };
             let masters = (0..4u32).flat_map(|i| [Master::Segment(i), Master::Node(i)]);
             for m in masters {
@@ -315,6 +345,16 @@ mod tests {
                     ),
                     (Some(a), None) => proptest::prop_assert!(a.g > reach, "{m:?}: dropped a hit with g = {}", a.g),
                     (None, Some(_)) => proptest::prop_assert!(false, "{m:?}: a hit the full detection does not find"),
+                    (None, None) => {}
+                }
+                // Against the full geometry: `detect` is `attach` filtered on its flag, to the bit, up to `reach`.
+                match (full.attach(m, [px, py]).filter(|(_, inside)| *inside), b) {
+                    (Some((a, _)), Some(b)) => proptest::prop_assert_eq!(
+                        (a.g.to_bits(), a.n.map(f64::to_bits), a.na.to_bits()),
+                        (b.g.to_bits(), b.n.map(f64::to_bits), b.na.to_bits())
+                    ),
+                    (Some((a, _)), None) => proptest::prop_assert!(a.g > reach, "{m:?}: dropped g = {}", a.g),
+                    (None, Some(_)) => proptest::prop_assert!(false, "{m:?}: a hit outside the detection zone"),
                     (None, None) => {}
                 }
             }
@@ -336,6 +376,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         assert!(det.attach(Master::Node(0), [0.05, 0.05]).is_none());
         // Both walls act on a particle in the corner.
@@ -360,6 +401,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         assert!(det.detect(Master::Node(1), [1.05, 0.0]).unwrap().g < 0.0);
         assert!(det.detect(Master::Node(0), [-0.05, 0.0]).unwrap().g < 0.0);

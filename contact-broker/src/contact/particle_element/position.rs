@@ -4,15 +4,18 @@
 //! (`projection.rs`).
 
 use super::detection::{Hit, Master};
+use super::memo::Memo;
 use super::pairs::Out;
 use super::projection;
 use super::report::ContactReport;
+use super::rigid::Gaps;
 use super::setup::{Mark, Setup};
 use crate::contact::bodies::{Nodes, Particles};
 use crate::contact::geometry::{axpy, Vec2};
 
 /// Runs the position sweeps until a sweep's deepest penetration is within `tol_x` or `params.sweeps` are done.
-/// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them.
+/// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them;
+/// `gaps` and `memo` too (their gaps, [`Gaps`], and those kept per particle, [`Memo`]).
 ///
 /// While every master is immovable in this phase (masters held, or all nodes fixed: `Setup::nodes_static`), the
 /// nodes do not move, so a visit depends on nothing but the particle's own position. A particle that a visit left
@@ -25,6 +28,8 @@ pub(super) fn phase(
     nodes: &mut Nodes,
     masters: &mut Vec<Master>,
     rigid: &mut Vec<Master>,
+    gaps: &mut Gaps,
+    memo: &mut Memo,
     marks: &mut [Mark],
     out: Out,
 ) {
@@ -66,7 +71,18 @@ pub(super) fn phase(
                 pairs.record(s, m, h.g, lam, 0.0);
                 mark.corrected = true;
             }
-            // Immovable masters: the exact limit of the sweeps, per particle.
+            // Immovable masters: the exact limit of the sweeps, per particle. While the nodes are static, the gaps
+            // a visit ends with are kept for the next visit at the same position (`memo.rs`).
+            let memo_gaps = if setup.nodes_static {
+                memo.gaps(mark.memo, particles.x[s], rigid)
+            } else {
+                None
+            };
+            let known = memo_gaps.is_some_and(|g| {
+                gaps.x0.clear();
+                gaps.x0.extend_from_slice(g);
+                true
+            });
             let projected = projection::position(
                 setup,
                 particles,
@@ -74,6 +90,8 @@ pub(super) fn phase(
                 nodes.x,
                 rigid,
                 first,
+                gaps,
+                known,
                 Out {
                     report: &mut *report,
                     pairs: &mut *pairs,
@@ -88,6 +106,12 @@ pub(super) fn phase(
             }
             if projected.moved {
                 mark.corrected = true;
+            }
+            // Kept for the particles visited again: by the next sweep (penetrated), or by the touching set (a
+            // master within the touch gap); a memo that still holds needs no copy.
+            let revisited = projected.penetrated || !mark.clear;
+            if setup.nodes_static && projected.gaps_valid && revisited && (projected.moved || !known) {
+                mark.memo = Some(memo.push(particles.x[s], rigid, &gaps.x0));
             }
         }
         report.position_sweeps += 1;

@@ -7,7 +7,7 @@ use std::borrow::Cow;
 use super::detection::{Detector, Master, Topology};
 use super::params::ContactParams;
 use crate::contact::bodies::{Nodes, Segment};
-use crate::contact::geometry::{sub, Vec2};
+use crate::contact::geometry::{sub, Frame, Vec2};
 use crate::contact::grid::CellGrid;
 
 /// What the pass knows about one particle: whether it was corrected, and what its position-phase visits learnt,
@@ -20,6 +20,16 @@ pub(super) struct Mark {
     pub still: bool,
     /// Its first-sweep visit found no master within the touch gap at its position.
     pub clear: bool,
+    /// Its memo ([`Memo`](super::memo::Memo)): the gaps its last position-phase visit ended with.
+    pub memo: Option<u32>,
+}
+
+/// What a pass computes once when its nodes are static (`Setup::nodes_static`) instead of at each detection: the
+/// frame of every segment, and which nodes may act as masters at all (`Detector::node_may_act`). Scratch.
+#[derive(Clone, Debug, Default)]
+pub(super) struct StaticGeometry {
+    frames: Vec<Option<Frame>>,
+    node_acts: Vec<bool>,
 }
 
 /// The context of one pass, fixed for its whole length (node positions are not in it: they change in the position
@@ -48,15 +58,20 @@ pub(super) struct Setup<'a> {
     /// Contacts within this gap after the position phase get the velocity correction [m].
     pub touch: f64,
     min_len: f64,
+    /// Frames and acting nodes, computed once while the nodes are static.
+    statics: Option<&'a StaticGeometry>,
 }
 
 impl<'a> Setup<'a> {
     /// Builds the node → segment tables, the inverse masses and the segment grid into the workspace's arrays and
-    /// derives the tolerances from `params` and the node coordinates. `segments` is not empty.
+    /// derives the tolerances from `params` and the node coordinates; with static nodes, also `statics`.
+    /// `segments` is not empty.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         grid: &'a mut CellGrid,
         topo: &'a mut Topology,
         inv_m: &'a mut Vec<f64>,
+        statics: &'a mut StaticGeometry,
         nodes: &Nodes<'a>,
         segments: &'a [Segment],
         params: &ContactParams,
@@ -98,6 +113,24 @@ impl<'a> Setup<'a> {
             Cow::Owned(vec![true; nn])
         };
         let nodes_static = !exhaustive && pos_fixed.iter().all(|&f| f);
+        let min_len = 1e-12 * r_c;
+        let topo = &*topo;
+        let statics = nodes_static.then(|| {
+            let det = Detector {
+                x: nodes.x,
+                segments,
+                topo,
+                thickness: params.thickness,
+                far_side: params.far_side,
+                min_len,
+                reach: f64::INFINITY,
+                frames: None,
+            };
+            det.frames_into(&mut statics.frames);
+            statics.node_acts.clear();
+            statics.node_acts.extend((0..nn).map(|k| det.node_may_act(k)));
+            &*statics
+        });
         Setup {
             params: *params,
             segments,
@@ -111,7 +144,8 @@ impl<'a> Setup<'a> {
             tol_x,
             tol_round,
             touch,
-            min_len: 1e-12 * r_c,
+            min_len,
+            statics,
         }
     }
 
@@ -126,11 +160,13 @@ impl<'a> Setup<'a> {
             min_len: self.min_len,
             // The touch gap: no caller of `detect` here acts on a larger gap.
             reach: self.touch,
+            frames: self.statics.map(|g| &g.frames[..]),
         }
     }
 
     /// The masters near `xs` (node positions `x`), in a fixed order: those of the segments in its grid cell whose
-    /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box).
+    /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box); with static
+    /// nodes, not the nodes that act nowhere.
     pub fn gather(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
         out.clear();
         for &j in self.grid.query(xs) {
@@ -141,6 +177,10 @@ impl<'a> Setup<'a> {
             if !(outside(0) || outside(1)) {
                 self.topo.masters_near(j as usize, s, out);
             }
+        }
+        // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out changes nothing.
+        if let Some(g) = self.statics {
+            out.retain(|m| !matches!(*m, Master::Node(k) if !g.node_acts[k as usize]));
         }
     }
 }
