@@ -63,12 +63,16 @@ impl Topology {
     /// Appends the masters a particle near segment `j` may touch, in a fixed order: the segment, then the node it
     /// ends at (owned by this segment when it is that node's first incoming segment), then the node it starts at
     /// when that node starts an open chain. Each node master is thus listed under exactly one segment.
-    pub fn masters_near(&self, j: usize, s: Segment, out: &mut Vec<Master>) {
+    ///
+    /// With `acts` (per node, `Detector::node_may_act`), a node that acts nowhere is left out: it would find no
+    /// contact wherever the particle is.
+    pub fn masters_near(&self, j: usize, s: Segment, acts: Option<&[bool]>, out: &mut Vec<Master>) {
+        let acting = |k: usize| acts.is_none_or(|a| a[k]);
         out.push(Master::Segment(j as u32));
-        if self.prev[s.b] == j as u32 {
+        if self.prev[s.b] == j as u32 && acting(s.b) {
             out.push(Master::Node(s.b as u32));
         }
-        if self.prev[s.a] == NONE && self.next[s.a] == j as u32 {
+        if self.prev[s.a] == NONE && self.next[s.a] == j as u32 && acting(s.a) {
             out.push(Master::Node(s.a as u32));
         }
     }
@@ -131,6 +135,20 @@ impl Detector<'_> {
         }
     }
 
+    /// The detection zone: [`Detector::detect`] finds no contact for a particle farther than this from a segment
+    /// (beyond `far` on the fluid side, `back` behind it, or outside its ξ range) or from a node master.
+    pub fn zone(&self) -> f64 {
+        let (far, back) = self.reaches();
+        far.max(back)
+    }
+
+    /// `far` and `back` of [`Detector::detect`]: twice the largest distance a caller looks at on the fluid side
+    /// (far above any round-off between detect's tests and `attach`), and the far-side limit plus r_c behind.
+    #[inline]
+    fn reaches(&self) -> (f64, f64) {
+        (2.0 * (self.thickness + self.reach), self.far_side + self.thickness)
+    }
+
     /// The contact geometry of particle position `xs` with master `m` when `xs` lies in the master's detection
     /// zone (any gap; the caller tests `g`), else `None`. Same result as [`Detector::attach`] filtered on its flag,
     /// with the cheap rejections (ξ range, corner wedge) done before any square root.
@@ -139,8 +157,7 @@ impl Detector<'_> {
     /// particle among the masters gathered near it is mostly several spacings from all but one or two of them, and
     /// every caller ignores such a hit (they act on g < 0 or g ≤ reach only), so their results do not change.
     pub fn detect(&self, m: Master, xs: Vec2) -> Option<Hit> {
-        // Twice the largest distance a caller looks at: far above any round-off between this test and `attach`.
-        let far = 2.0 * (self.thickness + self.reach);
+        let (far, back) = self.reaches();
         match m {
             Master::Segment(j) => {
                 let s = self.segments[j as usize];
@@ -151,7 +168,6 @@ impl Detector<'_> {
                 // segment, where `attach` finds the particle outside (dn ≤ −d_max). Tested before ξ: no division,
                 // and most masters gathered near a particle are rejected here (the far face of a thin structure).
                 let dn_len = cross(sub(xs, x1), d);
-                let back = self.far_side + self.thickness;
                 let reach2 = if dn_len > 0.0 { far * far } else { back * back };
                 if dn_len * dn_len > reach2 * dot(d, d) {
                     return None;
@@ -391,7 +407,7 @@ mod tests {
         let mut topo = Topology::default();
         topo.build(2, &s);
         let mut m = Vec::new();
-        topo.masters_near(0, s[0], &mut m);
+        topo.masters_near(0, s[0], None, &mut m);
         assert_eq!(m, vec![Master::Segment(0), Master::Node(1), Master::Node(0)]);
         let det = Detector {
             x: &x,

@@ -42,11 +42,16 @@ pub(super) fn phase(
             if setup.nodes_static && !first && mark.still {
                 continue;
             }
-            setup.gather(nodes.x, particles.x[s], masters);
             mark.still = true;
             if first {
                 mark.clear = true;
             }
+            // Static nodes, first sweep: a particle with no master within the touch gap among those whose detection
+            // may find a contact (the rest find none) is neither moved nor near, the same outcome as the full visit.
+            if setup.nodes_static && first && clear(setup, nodes.x, particles.x[s], masters) {
+                continue;
+            }
+            setup.gather(nodes.x, particles.x[s], masters);
             if masters.is_empty() {
                 continue;
             }
@@ -119,6 +124,16 @@ pub(super) fn phase(
             break;
         }
     }
+}
+
+/// Whether no master near `xs` ([`Setup::gather_near`], into the scratch `masters`) is within the touch gap.
+fn clear(setup: &Setup, node_x: &[Vec2], xs: Vec2, masters: &mut Vec<Master>) -> bool {
+    setup.gather_near(node_x, xs, masters);
+    let d = setup.detector(node_x);
+    // NaN is not within the gap, as in `projection::position`.
+    masters
+        .iter()
+        .all(|&m| d.detect(m, xs).is_none_or(|h| !(h.g <= setup.touch)))
 }
 
 /// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`; the

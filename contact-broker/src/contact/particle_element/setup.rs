@@ -51,6 +51,8 @@ pub(super) struct Setup<'a> {
     pub nodes_static: bool,
     /// How far a segment's box is inflated for the candidate search.
     inflate: f64,
+    /// How far for [`Setup::gather_near`] (at most `inflate`).
+    inflate_near: f64,
     /// Convergence tolerance of the position phase [m].
     pub tol_x: f64,
     /// Round-off allowance of the exact rigid projection [m] (16 ulp of the coordinates).
@@ -115,17 +117,19 @@ impl<'a> Setup<'a> {
         let nodes_static = !exhaustive && pos_fixed.iter().all(|&f| f);
         let min_len = 1e-12 * r_c;
         let topo = &*topo;
+        let det = Detector {
+            x: nodes.x,
+            segments,
+            topo,
+            thickness: params.thickness,
+            far_side: params.far_side,
+            min_len,
+            reach: touch,
+            frames: None,
+        };
+        // The detection zone, with r_c more as a margin far above round-off (as `Detector::detect`'s own).
+        let inflate_near = (det.zone() + r_c).min(inflate);
         let statics = nodes_static.then(|| {
-            let det = Detector {
-                x: nodes.x,
-                segments,
-                topo,
-                thickness: params.thickness,
-                far_side: params.far_side,
-                min_len,
-                reach: f64::INFINITY,
-                frames: None,
-            };
             det.frames_into(&mut statics.frames);
             statics.node_acts.clear();
             statics.node_acts.extend((0..nn).map(|k| det.node_may_act(k)));
@@ -141,6 +145,7 @@ impl<'a> Setup<'a> {
             pos_fixed,
             nodes_static,
             inflate,
+            inflate_near,
             tol_x,
             tol_round,
             touch,
@@ -168,19 +173,27 @@ impl<'a> Setup<'a> {
     /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box); with static
     /// nodes, not the nodes that act nowhere.
     pub fn gather(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
+        self.gather_within(x, xs, self.inflate, out);
+    }
+
+    /// The masters of [`Setup::gather`] whose detection at `xs` may find a contact, with others: those of the
+    /// segments whose box inflated by the detection zone (plus r_c for round-off) holds `xs`. Any master
+    /// [`Setup::gather`] lists beyond it finds no contact at `xs` (`Detector::zone`).
+    pub fn gather_near(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
+        self.gather_within(x, xs, self.inflate_near, out);
+    }
+
+    fn gather_within(&self, x: &[Vec2], xs: Vec2, inflate: f64, out: &mut Vec<Master>) {
         out.clear();
+        // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out changes nothing.
+        let acts = self.statics.map(|g| &g.node_acts[..]);
         for &j in self.grid.query(xs) {
             let s = self.segments[j as usize];
             let (a, b) = (x[s.a], x[s.b]);
-            let inflate = self.inflate;
             let outside = |k: usize| xs[k] < a[k].min(b[k]) - inflate || xs[k] > a[k].max(b[k]) + inflate;
             if !(outside(0) || outside(1)) {
-                self.topo.masters_near(j as usize, s, out);
+                self.topo.masters_near(j as usize, s, acts, out);
             }
-        }
-        // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out changes nothing.
-        if let Some(g) = self.statics {
-            out.retain(|m| !matches!(*m, Master::Node(k) if !g.node_acts[k as usize]));
         }
     }
 }
