@@ -22,6 +22,7 @@ use crate::contact::geometry::{axpy, Vec2};
 /// where it was is then skipped by the later sweeps, and one that also touched nothing in the first sweep by the
 /// touching set ([`touching`](super::touching)): they would repeat the same detection on the same inputs and find
 /// the same nothing (bit-identical result).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn phase(
     setup: &Setup,
     particles: &mut Particles,
@@ -133,7 +134,7 @@ fn clear(setup: &Setup, node_x: &[Vec2], xs: Vec2, masters: &mut Vec<Master>) ->
     // NaN is not within the gap, as in `projection::position`.
     masters
         .iter()
-        .all(|&m| d.detect(m, xs).is_none_or(|h| !(h.g <= setup.touch)))
+        .all(|&m| d.detect(m, xs).is_none_or(|h| h.g > setup.touch || h.g.is_nan()))
 }
 
 /// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`; the

@@ -65,7 +65,7 @@ fn admit_into(det: &Detector, masters: &[Master], x: Vec2, tol: f64, out: &mut V
     out.clear();
     for &m in masters {
         let g = gap(det, m, x);
-        if !(g >= -tol) {
+        if g < -tol || g.is_nan() {
             return false;
         }
         out.push(g);

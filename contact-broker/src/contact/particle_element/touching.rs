@@ -22,6 +22,7 @@ pub(super) struct Contact {
 
 /// Collects into `contacts` every particle–master pair within `Setup::touch` of touching at particle positions
 /// `particle_x` and node positions `node_x`; `masters` is scratch, `memo` the gaps the position phase kept.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn collect(
     setup: &Setup,
     particle_x: &[Vec2],
@@ -48,7 +49,7 @@ pub(super) fn collect(
             None
         };
         for (i, &m) in masters.iter().enumerate() {
-            if known.is_some_and(|g| !(g[i] <= setup.touch)) {
+            if known.is_some_and(|g| g[i] > setup.touch || g[i].is_nan()) {
                 continue;
             }
             if let Some(hit) = d.detect(m, particle_x[s]).filter(|h| h.g <= setup.touch) {
