@@ -90,10 +90,11 @@ impl CellGrid {
         }
     }
 
-    /// Cell index ranges covered by a box (clamped to the grid).
+    /// Cell index ranges covered by a box (clamped to the grid). `max(0.0)` then the truncating cast is
+    /// `floor().max(0.0)` then the cast for every input (NaN included), without a call to `floor`.
     fn range(&self, (a, b): (Vec2, Vec2)) -> (usize, usize, usize, usize) {
-        let cx = |v: f64| (((v - self.origin[0]) / self.cell).floor().max(0.0) as usize).min(self.nx - 1);
-        let cy = |v: f64| (((v - self.origin[1]) / self.cell).floor().max(0.0) as usize).min(self.ny - 1);
+        let cx = |v: f64| (((v - self.origin[0]) / self.cell).max(0.0) as usize).min(self.nx - 1);
+        let cy = |v: f64| (((v - self.origin[1]) / self.cell).max(0.0) as usize).min(self.ny - 1);
         (cx(a[0]), cx(b[0]), cy(a[1]), cy(b[1]))
     }
 

@@ -63,12 +63,16 @@ impl Topology {
     /// Appends the masters a particle near segment `j` may touch, in a fixed order: the segment, then the node it
     /// ends at (owned by this segment when it is that node's first incoming segment), then the node it starts at
     /// when that node starts an open chain. Each node master is thus listed under exactly one segment.
-    pub fn masters_near(&self, j: usize, s: Segment, out: &mut Vec<Master>) {
+    ///
+    /// With `acts` (per node, `Detector::node_may_act`), a node that acts nowhere is left out: it would find no
+    /// contact wherever the particle is.
+    pub fn masters_near(&self, j: usize, s: Segment, acts: Option<&[bool]>, out: &mut Vec<Master>) {
+        let acting = |k: usize| acts.is_none_or(|a| a[k]);
         out.push(Master::Segment(j as u32));
-        if self.prev[s.b] == j as u32 {
+        if self.prev[s.b] == j as u32 && acting(s.b) {
             out.push(Master::Node(s.b as u32));
         }
-        if self.prev[s.a] == NONE && self.next[s.a] == j as u32 {
+        if self.prev[s.a] == NONE && self.next[s.a] == j as u32 && acting(s.a) {
             out.push(Master::Node(s.a as u32));
         }
     }
@@ -88,12 +92,36 @@ pub(crate) struct Detector<'a> {
     /// The largest gap g any caller acts on (the touch gap of the velocity phase; `f64::INFINITY` for every
     /// contact): [`Detector::detect`] may answer `None` for a master whose gap is certainly above it.
     pub reach: f64,
+    /// The frame of every segment at `x` (`Frame::new` of its nodes, `None` for a collapsed one), when the caller
+    /// computed them once for nodes that do not move; `None`: computed at each use.
+    pub frames: Option<&'a [Option<Frame>]>,
 }
 
 impl Detector<'_> {
     fn frame(&self, j: u32) -> Option<Frame> {
+        if let Some(frames) = self.frames {
+            return frames[j as usize];
+        }
         let s = self.segments[j as usize];
         Frame::new(self.x[s.a], self.x[s.b], self.min_len)
+    }
+
+    /// Fills `out` with the frame of every segment at these node positions (what [`Detector::frames`] holds).
+    pub fn frames_into(&self, out: &mut Vec<Option<Frame>>) {
+        out.clear();
+        out.extend(
+            self.segments
+                .iter()
+                .map(|s| Frame::new(self.x[s.a], self.x[s.b], self.min_len)),
+        );
+    }
+
+    /// Whether node `k` may act as a master at these node positions: `false` at a concave or straight corner,
+    /// where [`Detector::detect`] finds no contact wherever the particle is (its corner test, which depends on the
+    /// nodes only).
+    pub fn node_may_act(&self, k: usize) -> bool {
+        let (p, q) = (self.topo.prev[k], self.topo.next[k]);
+        !(p != NONE && q != NONE && cross(self.delta(p), self.delta(q)) <= 0.0)
     }
 
     /// Whether the master cannot move (all its nodes fixed: infinite mass, 1/m = 0).
@@ -107,6 +135,20 @@ impl Detector<'_> {
         }
     }
 
+    /// The detection zone: [`Detector::detect`] finds no contact for a particle farther than this from a segment
+    /// (beyond `far` on the fluid side, `back` behind it, or outside its ξ range) or from a node master.
+    pub fn zone(&self) -> f64 {
+        let (far, back) = self.reaches();
+        far.max(back)
+    }
+
+    /// `far` and `back` of [`Detector::detect`]: twice the largest distance a caller looks at on the fluid side
+    /// (far above any round-off between detect's tests and `attach`), and the far-side limit plus r_c behind.
+    #[inline]
+    fn reaches(&self) -> (f64, f64) {
+        (2.0 * (self.thickness + self.reach), self.far_side + self.thickness)
+    }
+
     /// The contact geometry of particle position `xs` with master `m` when `xs` lies in the master's detection
     /// zone (any gap; the caller tests `g`), else `None`. Same result as [`Detector::attach`] filtered on its flag,
     /// with the cheap rejections (ξ range, corner wedge) done before any square root.
@@ -115,19 +157,22 @@ impl Detector<'_> {
     /// particle among the masters gathered near it is mostly several spacings from all but one or two of them, and
     /// every caller ignores such a hit (they act on g < 0 or g ≤ reach only), so their results do not change.
     pub fn detect(&self, m: Master, xs: Vec2) -> Option<Hit> {
-        // Twice the largest distance a caller looks at: far above any round-off between this test and `attach`.
-        let far = 2.0 * (self.thickness + self.reach);
+        let (far, back) = self.reaches();
         match m {
             Master::Segment(j) => {
                 let s = self.segments[j as usize];
                 let x1 = self.x[s.a];
                 let d = sub(self.x[s.b], x1);
-                if !(0.0..=1.0).contains(&xi(x1, d, xs)) {
+                // (x_s − x_c)·n · L = (x_s − x1) × d, n = (t_y, −t_x) (`Frame`): beyond `far` on the fluid side, or
+                // beyond the far-side limit plus r_c (a margin as far above round-off as `far`'s) behind the
+                // segment, where `attach` finds the particle outside (dn ≤ −d_max). Tested before ξ: no division,
+                // and most masters gathered near a particle are rejected here (the far face of a thin structure).
+                let dn_len = cross(sub(xs, x1), d);
+                let reach2 = if dn_len > 0.0 { far * far } else { back * back };
+                if dn_len * dn_len > reach2 * dot(d, d) {
                     return None;
                 }
-                // (x_s − x_c)·n · L = (x_s − x1) × d, n = (t_y, −t_x) (`Frame`): beyond `far` on the fluid side.
-                let dn_len = cross(sub(xs, x1), d);
-                if dn_len > 0.0 && dn_len * dn_len > far * far * dot(d, d) {
+                if !(0.0..=1.0).contains(&xi(x1, d, xs)) {
                     return None;
                 }
             }
@@ -272,6 +317,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         // Below the bottom edge (fluid side), 0.05 away: penetrates the 0.1 thickness by 0.05.
         let h = det.detect(Master::Segment(0), [0.25, -0.05]).unwrap();
@@ -303,7 +349,7 @@ mod tests {
             let mut topo = Topology::default();
             topo.build(4, &s);
             let full = Detector { x: &x, segments: &s, topo: &topo, thickness: 0.1, far_side: 0.3, min_len: 0.0,
-                reach: f64::INFINITY };
+                reach: f64::INFINITY, frames: None };
             let near = Detector { reach, ..full };
             let masters = (0..4u32).flat_map(|i| [Master::Segment(i), Master::Node(i)]);
             for m in masters {
@@ -315,6 +361,16 @@ mod tests {
                     ),
                     (Some(a), None) => proptest::prop_assert!(a.g > reach, "{m:?}: dropped a hit with g = {}", a.g),
                     (None, Some(_)) => proptest::prop_assert!(false, "{m:?}: a hit the full detection does not find"),
+                    (None, None) => {}
+                }
+                // Against the full geometry: `detect` is `attach` filtered on its flag, to the bit, up to `reach`.
+                match (full.attach(m, [px, py]).filter(|(_, inside)| *inside), b) {
+                    (Some((a, _)), Some(b)) => proptest::prop_assert_eq!(
+                        (a.g.to_bits(), a.n.map(f64::to_bits), a.na.to_bits()),
+                        (b.g.to_bits(), b.n.map(f64::to_bits), b.na.to_bits())
+                    ),
+                    (Some((a, _)), None) => proptest::prop_assert!(a.g > reach, "{m:?}: dropped g = {}", a.g),
+                    (None, Some(_)) => proptest::prop_assert!(false, "{m:?}: a hit outside the detection zone"),
                     (None, None) => {}
                 }
             }
@@ -336,6 +392,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         assert!(det.attach(Master::Node(0), [0.05, 0.05]).is_none());
         // Both walls act on a particle in the corner.
@@ -350,7 +407,7 @@ mod tests {
         let mut topo = Topology::default();
         topo.build(2, &s);
         let mut m = Vec::new();
-        topo.masters_near(0, s[0], &mut m);
+        topo.masters_near(0, s[0], None, &mut m);
         assert_eq!(m, vec![Master::Segment(0), Master::Node(1), Master::Node(0)]);
         let det = Detector {
             x: &x,
@@ -360,6 +417,7 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         assert!(det.detect(Master::Node(1), [1.05, 0.0]).unwrap().g < 0.0);
         assert!(det.detect(Master::Node(0), [-0.05, 0.0]).unwrap().g < 0.0);

@@ -14,6 +14,7 @@
 //! [`ParticleElement`] is the [`ContactAlgorithm`] that runs it with its own [`ParticleElementWorkspace`].
 
 mod detection;
+mod memo;
 mod pairs;
 mod params;
 mod position;
@@ -79,9 +80,12 @@ pub fn particle_element_with(
         grid,
         topo,
         inv_m,
+        statics,
         marks,
         masters,
         rigid,
+        gaps,
+        memo,
         contacts,
         planes,
         exhaustive,
@@ -90,21 +94,33 @@ pub fn particle_element_with(
     pairs.clear();
     marks.clear();
     marks.resize(particles.x.len(), Mark::default());
+    memo.clear();
 
-    let setup = Setup::new(grid, topo, inv_m, &nodes, segments, params, *exhaustive);
+    let setup = Setup::new(grid, topo, inv_m, statics, &nodes, segments, params, *exhaustive);
     position::phase(
         &setup,
         &mut particles,
         &mut nodes,
         masters,
         rigid,
+        gaps,
+        memo,
         marks,
         Out {
             report: &mut report,
             pairs,
         },
     );
-    touching::collect(&setup, particles.x, nodes.x, marks, masters, contacts, &mut report);
+    touching::collect(
+        &setup,
+        particles.x,
+        nodes.x,
+        marks,
+        memo,
+        masters,
+        contacts,
+        &mut report,
+    );
     velocity::phase(
         &setup,
         &mut particles,

@@ -4,27 +4,33 @@
 //! (`projection.rs`).
 
 use super::detection::{Hit, Master};
+use super::memo::Memo;
 use super::pairs::Out;
 use super::projection;
 use super::report::ContactReport;
+use super::rigid::Gaps;
 use super::setup::{Mark, Setup};
 use crate::contact::bodies::{Nodes, Particles};
 use crate::contact::geometry::{axpy, Vec2};
 
 /// Runs the position sweeps until a sweep's deepest penetration is within `tol_x` or `params.sweeps` are done.
-/// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them.
+/// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them;
+/// `gaps` and `memo` too (their gaps, [`Gaps`], and those kept per particle, [`Memo`]).
 ///
 /// While every master is immovable in this phase (masters held, or all nodes fixed: `Setup::nodes_static`), the
 /// nodes do not move, so a visit depends on nothing but the particle's own position. A particle that a visit left
 /// where it was is then skipped by the later sweeps, and one that also touched nothing in the first sweep by the
 /// touching set ([`touching`](super::touching)): they would repeat the same detection on the same inputs and find
 /// the same nothing (bit-identical result).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn phase(
     setup: &Setup,
     particles: &mut Particles,
     nodes: &mut Nodes,
     masters: &mut Vec<Master>,
     rigid: &mut Vec<Master>,
+    gaps: &mut Gaps,
+    memo: &mut Memo,
     marks: &mut [Mark],
     out: Out,
 ) {
@@ -37,11 +43,16 @@ pub(super) fn phase(
             if setup.nodes_static && !first && mark.still {
                 continue;
             }
-            setup.gather(nodes.x, particles.x[s], masters);
             mark.still = true;
             if first {
                 mark.clear = true;
             }
+            // Static nodes, first sweep: a particle with no master within the touch gap among those whose detection
+            // may find a contact (the rest find none) is neither moved nor near, the same outcome as the full visit.
+            if setup.nodes_static && first && clear(setup, nodes.x, particles.x[s], masters) {
+                continue;
+            }
+            setup.gather(nodes.x, particles.x[s], masters);
             if masters.is_empty() {
                 continue;
             }
@@ -66,7 +77,18 @@ pub(super) fn phase(
                 pairs.record(s, m, h.g, lam, 0.0);
                 mark.corrected = true;
             }
-            // Immovable masters: the exact limit of the sweeps, per particle.
+            // Immovable masters: the exact limit of the sweeps, per particle. While the nodes are static, the gaps
+            // a visit ends with are kept for the next visit at the same position (`memo.rs`).
+            let memo_gaps = if setup.nodes_static {
+                memo.gaps(mark.memo, particles.x[s], rigid)
+            } else {
+                None
+            };
+            let known = memo_gaps.is_some_and(|g| {
+                gaps.x0.clear();
+                gaps.x0.extend_from_slice(g);
+                true
+            });
             let projected = projection::position(
                 setup,
                 particles,
@@ -74,6 +96,8 @@ pub(super) fn phase(
                 nodes.x,
                 rigid,
                 first,
+                gaps,
+                known,
                 Out {
                     report: &mut *report,
                     pairs: &mut *pairs,
@@ -89,12 +113,28 @@ pub(super) fn phase(
             if projected.moved {
                 mark.corrected = true;
             }
+            // Kept for the particles visited again: by the next sweep (penetrated), or by the touching set (a
+            // master within the touch gap); a memo that still holds needs no copy.
+            let revisited = projected.penetrated || !mark.clear;
+            if setup.nodes_static && projected.gaps_valid && revisited && (projected.moved || !known) {
+                mark.memo = Some(memo.push(particles.x[s], rigid, &gaps.x0));
+            }
         }
         report.position_sweeps += 1;
         if worst <= setup.tol_x {
             break;
         }
     }
+}
+
+/// Whether no master near `xs` ([`Setup::gather_near`], into the scratch `masters`) is within the touch gap.
+fn clear(setup: &Setup, node_x: &[Vec2], xs: Vec2, masters: &mut Vec<Master>) -> bool {
+    setup.gather_near(node_x, xs, masters);
+    let d = setup.detector(node_x);
+    // NaN is not within the gap, as in `projection::position`.
+    masters
+        .iter()
+        .all(|&m| d.detect(m, xs).is_none_or(|h| h.g > setup.touch || h.g.is_nan()))
 }
 
 /// The position correction of one penetrating contact `h` of a particle with inverse mass `im_s` at `x_s`; the

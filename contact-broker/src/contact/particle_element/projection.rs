@@ -6,7 +6,7 @@
 use super::detection::{Detector, Hit, Master};
 use super::pairs::{Out, PairLog};
 use super::report::ContactReport;
-use super::rigid::{position_step, velocity_step, HalfPlane};
+use super::rigid::{position_step, velocity_step, Gaps, HalfPlane};
 use super::setup::Setup;
 use crate::contact::bodies::Particles;
 use crate::contact::geometry::{axpy, cross, dot, sub, Vec2};
@@ -26,11 +26,14 @@ pub(super) struct Projected {
     pub penetrated: bool,
     /// The particle was moved.
     pub moved: bool,
+    /// `gaps.x0` holds the gaps of the masters at the particle's final position.
+    pub gaps_valid: bool,
 }
 
 /// Projects particle `s` out of its immovable masters `rigid` (node positions `node_x`) in one position sweep,
 /// `first` when it is the first; the penetrations found before the first step of the first sweep are counted in
-/// `report`.
+/// `report`. `gaps` is scratch; `known`: `gaps.x0` already holds the masters' gaps at the particle's position.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn position(
     setup: &Setup,
     particles: &mut Particles,
@@ -38,29 +41,34 @@ pub(super) fn position(
     node_x: &[Vec2],
     rigid: &[Master],
     first: bool,
+    gaps: &mut Gaps,
+    mut known: bool,
     out: Out,
 ) -> Projected {
     let Out { report, pairs } = out;
     let mut out = Projected::default();
+    // `known`: whether `gaps.x0` holds the gaps at the particle's position (the last step computed them to admit it).
     for step in 0..RIGID_STEPS {
         if rigid.is_empty() {
             break;
         }
         let d = setup.detector(node_x);
         let x0 = particles.x[s];
+        if !known {
+            gaps.fill_x0(&d, rigid, x0);
+            known = true;
+        }
         let mut penetrated = false;
-        for &m in rigid.iter() {
-            let Some(h) = d.detect(m, x0) else {
-                continue;
-            };
-            if first && step == 0 && h.g <= setup.touch {
+        // A master that finds no contact has an infinite gap: neither near nor penetrated.
+        for (&m, &g) in rigid.iter().zip(&gaps.x0) {
+            if first && step == 0 && g <= setup.touch {
                 out.near = true;
             }
-            if h.g < 0.0 {
+            if g < 0.0 {
                 penetrated = true;
-                out.worst = out.worst.max(-h.g);
+                out.worst = out.worst.max(-g);
                 if first && step == 0 {
-                    report.note_contact(m, h.g);
+                    report.note_contact(m, g);
                 }
             }
         }
@@ -69,9 +77,10 @@ pub(super) fn position(
             break;
         }
         out.penetrated = true;
-        let Some(st) = position_step(&d, rigid, x0, setup.tol_round) else {
+        let Some(st) = position_step(&d, rigid, x0, setup.tol_round, gaps) else {
             break;
         };
+        known = st.gaps_at_x;
         // The particle's change m_s Δx is balanced by reactions −m_s μ_j N_a n_j on the fixed nodes.
         let delta = sub(st.x, x0);
         let m_s = particles.m[s];
@@ -86,6 +95,7 @@ pub(super) fn position(
         particles.x[s] = st.x;
         out.moved = true;
     }
+    out.gaps_valid = known && !rigid.is_empty();
     out
 }
 

@@ -22,18 +22,74 @@ const MAX_SET: usize = 8;
 pub(crate) struct PositionStep {
     pub x: Vec2,
     pub by: [Option<usize>; 2],
+    /// [`Gaps::x0`] now holds the gaps at `x` (the step landed on an admissible candidate, whose gaps were all
+    /// computed to admit it); otherwise it is stale.
+    pub gaps_at_x: bool,
+}
+
+/// Per-master gaps (`f64::INFINITY` where a master finds no contact) that one exact step computes anyway, kept so
+/// that no detection is repeated at the same point with the same master: the gaps at the particle's position, at
+/// each single projection, at the candidate being admitted and at the best one so far. Scratch only.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Gaps {
+    /// At the position the step starts from (filled by the caller), then at the step's result (`gaps_at_x`).
+    pub x0: Vec<f64>,
+    proj: Vec<f64>,
+    cand: Vec<f64>,
+    best: Vec<f64>,
+}
+
+impl Gaps {
+    /// Fills [`Gaps::x0`] with the gaps of `masters` at `x`.
+    pub fn fill_x0(&mut self, det: &Detector, masters: &[Master], x: Vec2) {
+        self.x0.clear();
+        self.x0.extend(masters.iter().map(|&m| gap(det, m, x)));
+    }
+}
+
+/// The gap of master `m` at `x`, or infinity where it finds no contact.
+#[inline]
+fn gap(det: &Detector, m: Master, x: Vec2) -> f64 {
+    det.detect(m, x).map_or(f64::INFINITY, |h| h.g)
+}
+
+/// Whether no gap in `gaps` is below −`tol` (NaN is not admissible).
+#[inline]
+fn admits(gaps: &[f64], tol: f64) -> bool {
+    gaps.iter().all(|&g| g >= -tol)
+}
+
+/// Fills `out` with the gaps of `masters` at `x` while they admit `x` (no gap below −`tol`); whether all do. The
+/// same answer as `masters.iter().all(|&m| gap(m, x) >= -tol)`, which stops at the first that does not.
+fn admit_into(det: &Detector, masters: &[Master], x: Vec2, tol: f64, out: &mut Vec<f64>) -> bool {
+    out.clear();
+    for &m in masters {
+        let g = gap(det, m, x);
+        if g < -tol || g.is_nan() {
+            return false;
+        }
+        out.push(g);
+    }
+    true
 }
 
 /// One exact position step for a particle at `x0` against the immovable `masters`, or `None` when none is
-/// penetrated (g < 0). Candidates are admissible when no master's gap is below −`tol`.
-pub(crate) fn position_step(det: &Detector, masters: &[Master], x0: Vec2, tol: f64) -> Option<PositionStep> {
-    let gap = |m: Master, x: Vec2| det.detect(m, x).map_or(f64::INFINITY, |h| h.g);
+/// penetrated (g < 0). Candidates are admissible when no master's gap is below −`tol`. `gaps.x0` must hold the
+/// masters' gaps at `x0` ([`Gaps::fill_x0`]).
+pub(crate) fn position_step(
+    det: &Detector,
+    masters: &[Master],
+    x0: Vec2,
+    tol: f64,
+    gaps: &mut Gaps,
+) -> Option<PositionStep> {
+    let n = masters.len();
+    debug_assert_eq!(gaps.x0.len(), n);
     // Deepest violation at x0 (first in order on ties).
     let mut deepest: Option<(usize, f64)> = None;
     let mut set = [0usize; MAX_SET];
     let mut len = 0;
-    for (i, &m) in masters.iter().enumerate() {
-        let g = gap(m, x0);
+    for (i, &g) in gaps.x0.iter().enumerate() {
         if g < 0.0 {
             if deepest.is_none_or(|(_, d)| g < d) {
                 deepest = Some((i, g));
@@ -45,32 +101,66 @@ pub(crate) fn position_step(det: &Detector, masters: &[Master], x0: Vec2, tol: f
         }
     }
     let (deep, _) = deepest?;
-    let admissible = |x: Vec2| masters.iter().all(|&m| gap(m, x) >= -tol);
 
-    // Add the constraints that a single projection runs into.
+    // Add the constraints that a single projection runs into. Every master's gap at each single projection is
+    // kept: the projection is the first candidate below, admitted on those very gaps.
     let violated_at_start = len;
+    let mut projected = [false; MAX_SET];
+    gaps.proj.clear();
+    gaps.proj.resize(violated_at_start * n, f64::INFINITY);
     for k in 0..violated_at_start {
         let Some(p) = det.shape(masters[set[k]]).map(|s| project(s, x0)) else {
             continue;
         };
+        projected[k] = true;
+        let row = &mut gaps.proj[k * n..(k + 1) * n];
         for (i, &m) in masters.iter().enumerate() {
-            if len < MAX_SET && !set[..len].contains(&i) && gap(m, p) < 0.0 {
+            let g = gap(det, m, p);
+            row[i] = g;
+            if len < MAX_SET && !set[..len].contains(&i) && g < 0.0 {
                 set[len] = i;
                 len += 1;
             }
         }
     }
 
+    // The nearest admissible candidate (the first on ties); its gaps go to `gaps.best`.
     let mut best: Option<(f64, PositionStep)> = None;
-    let mut consider = |x: Vec2, by: [Option<usize>; 2]| {
+    let Gaps {
+        proj,
+        cand,
+        best: best_gaps,
+        ..
+    } = gaps;
+    let mut consider = |x: Vec2, by: [Option<usize>; 2], known: Option<&[f64]>| {
         let d2 = dot(sub(x, x0), sub(x, x0));
-        if best.as_ref().is_none_or(|(b, _)| d2 < *b) && admissible(x) {
-            best = Some((d2, PositionStep { x, by }));
+        if !best.as_ref().is_none_or(|(b, _)| d2 < *b) {
+            return;
+        }
+        let admitted = match known {
+            Some(row) => {
+                admits(row, tol) && {
+                    best_gaps.clear();
+                    best_gaps.extend_from_slice(row);
+                    true
+                }
+            }
+            None => {
+                admit_into(det, masters, x, tol, cand) && {
+                    std::mem::swap(cand, best_gaps);
+                    true
+                }
+            }
+        };
+        if admitted {
+            best = Some((d2, PositionStep { x, by, gaps_at_x: true }));
         }
     };
-    for &i in &set[..len] {
+    for (k, &i) in set[..len].iter().enumerate() {
         if let Some(s) = det.shape(masters[i]) {
-            consider(project(s, x0), [Some(i), None]);
+            // The first `violated_at_start` are the single projections whose gaps are known.
+            let known = (k < violated_at_start && projected[k]).then(|| &proj[k * n..(k + 1) * n]);
+            consider(project(s, x0), [Some(i), None], known);
         }
     }
     for (k, &i) in set[..len].iter().enumerate() {
@@ -79,16 +169,20 @@ pub(crate) fn position_step(det: &Detector, masters: &[Master], x0: Vec2, tol: f
                 continue;
             };
             for x in intersections(si, sj).into_iter().flatten() {
-                consider(x, [Some(i), Some(j)]);
+                consider(x, [Some(i), Some(j)], None);
             }
         }
     }
     match best {
-        Some((_, step)) => Some(step),
+        Some((_, step)) => {
+            std::mem::swap(&mut gaps.x0, &mut gaps.best);
+            Some(step)
+        }
         // No admissible candidate: one Gauss–Seidel step on the deepest violation.
         None => det.shape(masters[deep]).map(|s| PositionStep {
             x: project(s, x0),
             by: [Some(deep), None],
+            gaps_at_x: false,
         }),
     }
 }
@@ -229,6 +323,12 @@ mod tests {
         (x, vec![Segment { a: 2, b: 1 }, Segment { a: 1, b: 0 }])
     }
 
+    fn step_at(det: &Detector, masters: &[Master], x: Vec2) -> Option<PositionStep> {
+        let mut gaps = Gaps::default();
+        gaps.fill_x0(det, masters, x);
+        position_step(det, masters, x, 1e-14, &mut gaps)
+    }
+
     #[test]
     fn acute_concave_corner_is_solved_exactly_in_one_step() {
         let (x, segs) = notch();
@@ -242,9 +342,10 @@ mod tests {
             far_side: 0.3,
             min_len: 0.0,
             reach: f64::INFINITY,
+            frames: None,
         };
         let masters = [Master::Segment(0), Master::Segment(1), Master::Node(1)];
-        let step = position_step(&det, &masters, [0.0, 0.05], 1e-14).unwrap();
+        let step = step_at(&det, &masters, [0.0, 0.05]).unwrap();
         // The apex of the two offset lines lies on the axis at r_c / sin(30°) = 0.2 above the corner.
         assert!(
             step.x[0].abs() < 1e-15 && (step.x[1] - 0.2).abs() < 1e-15,
@@ -252,7 +353,7 @@ mod tests {
             step.x
         );
         assert_eq!(step.by, [Some(0), Some(1)]);
-        assert!(position_step(&det, &masters, step.x, 1e-14).is_none_or(|s| (s.x[1] - 0.2).abs() < 1e-15));
+        assert!(step_at(&det, &masters, step.x).is_none_or(|s| (s.x[1] - 0.2).abs() < 1e-15));
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::borrow::Cow;
 use super::detection::{Detector, Master, Topology};
 use super::params::ContactParams;
 use crate::contact::bodies::{Nodes, Segment};
-use crate::contact::geometry::{sub, Vec2};
+use crate::contact::geometry::{sub, Frame, Vec2};
 use crate::contact::grid::CellGrid;
 
 /// What the pass knows about one particle: whether it was corrected, and what its position-phase visits learnt,
@@ -20,6 +20,16 @@ pub(super) struct Mark {
     pub still: bool,
     /// Its first-sweep visit found no master within the touch gap at its position.
     pub clear: bool,
+    /// Its memo ([`Memo`](super::memo::Memo)): the gaps its last position-phase visit ended with.
+    pub memo: Option<u32>,
+}
+
+/// What a pass computes once when its nodes are static (`Setup::nodes_static`) instead of at each detection: the
+/// frame of every segment, and which nodes may act as masters at all (`Detector::node_may_act`). Scratch.
+#[derive(Clone, Debug, Default)]
+pub(super) struct StaticGeometry {
+    frames: Vec<Option<Frame>>,
+    node_acts: Vec<bool>,
 }
 
 /// The context of one pass, fixed for its whole length (node positions are not in it: they change in the position
@@ -41,6 +51,8 @@ pub(super) struct Setup<'a> {
     pub nodes_static: bool,
     /// How far a segment's box is inflated for the candidate search.
     inflate: f64,
+    /// How far for [`Setup::gather_near`] (at most `inflate`).
+    inflate_near: f64,
     /// Convergence tolerance of the position phase [m].
     pub tol_x: f64,
     /// Round-off allowance of the exact rigid projection [m] (16 ulp of the coordinates).
@@ -48,15 +60,20 @@ pub(super) struct Setup<'a> {
     /// Contacts within this gap after the position phase get the velocity correction [m].
     pub touch: f64,
     min_len: f64,
+    /// Frames and acting nodes, computed once while the nodes are static.
+    statics: Option<&'a StaticGeometry>,
 }
 
 impl<'a> Setup<'a> {
     /// Builds the node → segment tables, the inverse masses and the segment grid into the workspace's arrays and
-    /// derives the tolerances from `params` and the node coordinates. `segments` is not empty.
+    /// derives the tolerances from `params` and the node coordinates; with static nodes, also `statics`.
+    /// `segments` is not empty.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         grid: &'a mut CellGrid,
         topo: &'a mut Topology,
         inv_m: &'a mut Vec<f64>,
+        statics: &'a mut StaticGeometry,
         nodes: &Nodes<'a>,
         segments: &'a [Segment],
         params: &ContactParams,
@@ -98,6 +115,26 @@ impl<'a> Setup<'a> {
             Cow::Owned(vec![true; nn])
         };
         let nodes_static = !exhaustive && pos_fixed.iter().all(|&f| f);
+        let min_len = 1e-12 * r_c;
+        let topo = &*topo;
+        let det = Detector {
+            x: nodes.x,
+            segments,
+            topo,
+            thickness: params.thickness,
+            far_side: params.far_side,
+            min_len,
+            reach: touch,
+            frames: None,
+        };
+        // The detection zone, with r_c more as a margin far above round-off (as `Detector::detect`'s own).
+        let inflate_near = (det.zone() + r_c).min(inflate);
+        let statics = nodes_static.then(|| {
+            det.frames_into(&mut statics.frames);
+            statics.node_acts.clear();
+            statics.node_acts.extend((0..nn).map(|k| det.node_may_act(k)));
+            &*statics
+        });
         Setup {
             params: *params,
             segments,
@@ -108,10 +145,12 @@ impl<'a> Setup<'a> {
             pos_fixed,
             nodes_static,
             inflate,
+            inflate_near,
             tol_x,
             tol_round,
             touch,
-            min_len: 1e-12 * r_c,
+            min_len,
+            statics,
         }
     }
 
@@ -126,20 +165,34 @@ impl<'a> Setup<'a> {
             min_len: self.min_len,
             // The touch gap: no caller of `detect` here acts on a larger gap.
             reach: self.touch,
+            frames: self.statics.map(|g| &g.frames[..]),
         }
     }
 
     /// The masters near `xs` (node positions `x`), in a fixed order: those of the segments in its grid cell whose
-    /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box).
+    /// box, inflated by `inflate`, holds `xs` (a node master lies within its owning segment's box); with static
+    /// nodes, not the nodes that act nowhere.
     pub fn gather(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
+        self.gather_within(x, xs, self.inflate, out);
+    }
+
+    /// The masters of [`Setup::gather`] whose detection at `xs` may find a contact, with others: those of the
+    /// segments whose box inflated by the detection zone (plus r_c for round-off) holds `xs`. Any master
+    /// [`Setup::gather`] lists beyond it finds no contact at `xs` (`Detector::zone`).
+    pub fn gather_near(&self, x: &[Vec2], xs: Vec2, out: &mut Vec<Master>) {
+        self.gather_within(x, xs, self.inflate_near, out);
+    }
+
+    fn gather_within(&self, x: &[Vec2], xs: Vec2, inflate: f64, out: &mut Vec<Master>) {
         out.clear();
+        // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out changes nothing.
+        let acts = self.statics.map(|g| &g.node_acts[..]);
         for &j in self.grid.query(xs) {
             let s = self.segments[j as usize];
             let (a, b) = (x[s.a], x[s.b]);
-            let inflate = self.inflate;
             let outside = |k: usize| xs[k] < a[k].min(b[k]) - inflate || xs[k] > a[k].max(b[k]) + inflate;
             if !(outside(0) || outside(1)) {
-                self.topo.masters_near(j as usize, s, out);
+                self.topo.masters_near(j as usize, s, acts, out);
             }
         }
     }

@@ -2,6 +2,7 @@
 //! corrected positions, grouped by particle in index order. They are the velocity phase's contacts.
 
 use super::detection::{Hit, Master};
+use super::memo::Memo;
 use super::report::ContactReport;
 use super::setup::{Mark, Setup};
 use crate::contact::geometry::Vec2;
@@ -20,12 +21,14 @@ pub(super) struct Contact {
 }
 
 /// Collects into `contacts` every particle–master pair within `Setup::touch` of touching at particle positions
-/// `particle_x` and node positions `node_x`; `masters` is scratch.
+/// `particle_x` and node positions `node_x`; `masters` is scratch, `memo` the gaps the position phase kept.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn collect(
     setup: &Setup,
     particle_x: &[Vec2],
     node_x: &[Vec2],
     marks: &[Mark],
+    memo: &Memo,
     masters: &mut Vec<Master>,
     contacts: &mut Vec<Contact>,
     report: &mut ContactReport,
@@ -38,7 +41,17 @@ pub(super) fn collect(
         }
         setup.gather(node_x, particle_x[s], masters);
         let d = setup.detector(node_x);
-        for &m in masters.iter() {
+        // The position phase's last gaps at this very position, where it kept them: only the masters within the
+        // touch gap are detected again (for their geometry).
+        let known = if setup.nodes_static {
+            memo.gaps(mark.memo, particle_x[s], masters)
+        } else {
+            None
+        };
+        for (i, &m) in masters.iter().enumerate() {
+            if known.is_some_and(|g| g[i] > setup.touch || g[i].is_nan()) {
+                continue;
+            }
             if let Some(hit) = d.detect(m, particle_x[s]).filter(|h| h.g <= setup.touch) {
                 report.residual_penetration = report.residual_penetration.max(-hit.g);
                 contacts.push(Contact {

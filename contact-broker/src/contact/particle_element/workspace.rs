@@ -1,9 +1,11 @@
 //! The scratch memory of the particle–element pass (`DESIGN.md` §2: state apart from scratch).
 
 use super::detection::{Master, Topology};
+use super::memo::Memo;
 use super::pairs::{ContactPair, PairLog};
 use super::projection::Planes;
-use super::setup::Mark;
+use super::rigid::Gaps;
+use super::setup::{Mark, StaticGeometry};
 use super::touching::Contact;
 use crate::contact::grid::CellGrid;
 
@@ -18,12 +20,18 @@ pub struct ParticleElementWorkspace {
     pub(super) topo: Topology,
     /// 1/m per node, 0 for a fixed one (set-up).
     pub(super) inv_m: Vec<f64>,
+    /// Segment frames and acting nodes of a pass with static nodes (set-up).
+    pub(super) statics: StaticGeometry,
     /// Per particle: corrected, and what the position phase learnt.
     pub(super) marks: Vec<Mark>,
     /// The masters near the particle being visited (position phase, touching set).
     pub(super) masters: Vec<Master>,
     /// The immovable ones of them (position phase).
     pub(super) rigid: Vec<Master>,
+    /// The gaps of the immovable masters the exact projection computes (position phase).
+    pub(super) gaps: Gaps,
+    /// The gaps the position phase kept per particle for its later visits.
+    pub(super) memo: Memo,
     /// The touching set: the velocity phase's contacts.
     pub(super) contacts: Vec<Contact>,
     /// The immovable contacts of the particle being visited (velocity phase).
