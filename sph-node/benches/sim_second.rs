@@ -2,7 +2,8 @@
 //! must pay for its pressure solve). `cargo bench -p sph-node --bench sim_second`.
 //!
 //! Each repetition runs both solvers one after the other from the same scene (`scenes/dam_break.toml`) for
-//! `SPH_BENCH_SIM_TIME` simulated seconds (default 0.05) at their own stable steps, 1 thread, in a child process of
+//! `SPH_BENCH_SIM_TIME` simulated seconds (default 0.05) at their own stable steps, on `SPH_BENCH_THREADS` threads
+//! (default 1), in a child process of
 //! its own (so that one solver's memory does not weigh on the other); the medians over `SPH_BENCH_REPS`
 //! repetitions (default 3) are printed with the steps taken and, for ISPH, the PPE's BiCGSTAB iterations per step
 //! (mean and largest). Sizes: `SPH_BENCH_SPACINGS` (default `0.001,0.0005`: 20,000 and 80,000 fluid particles).
@@ -35,9 +36,13 @@ fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
     std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(default)
 }
 
-/// Runs one solver for `t_end` simulated seconds in this process; prints `cpu_s steps it_mean it_max particles`.
+/// Runs one solver for `t_end` simulated seconds in this process; prints `cpu_s steps it_mean it_max particles
+/// wall_s`.
 fn child(spacing: f64, solver: &str, t_end: f64) {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(env_or("SPH_BENCH_THREADS", 1))
+        .build()
+        .unwrap();
     let scene = scene(spacing, solver);
     pool.install(|| {
         let mut fluid: Box<dyn FluidSolver> = match solver {
@@ -45,7 +50,7 @@ fn child(spacing: f64, solver: &str, t_end: f64) {
             _ => Box::new(WcsphSolver::new(&scene).unwrap()),
         };
         let n = fluid.state().len();
-        let c0 = cpu_seconds();
+        let (c0, w0) = (cpu_seconds(), std::time::Instant::now());
         let (mut t, mut steps, mut it_sum, mut it_max) = (0.0, 0u64, 0usize, 0usize);
         while t < t_end {
             let dt = fluid.stable_dt().min(t_end - t);
@@ -57,8 +62,8 @@ fn child(spacing: f64, solver: &str, t_end: f64) {
                 it_max = it_max.max(ppe);
             }
         }
-        let cpu = cpu_seconds() - c0;
-        println!("{cpu} {steps} {} {it_max} {n}", it_sum as f64 / steps as f64);
+        let (cpu, wall) = (cpu_seconds() - c0, w0.elapsed().as_secs_f64());
+        println!("{cpu} {steps} {} {it_max} {n} {wall}", it_sum as f64 / steps as f64);
     });
 }
 
@@ -82,15 +87,19 @@ fn main() {
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     let exe = std::env::current_exe().unwrap();
-    println!("dam break, {t_end} s simulated, 1 thread, median of {reps} (interleaved)");
     println!(
-        "{:>9} {:>6} {:>16} {:>8} {:>10} {:>14}",
-        "fluid", "solver", "CPU-s per sim s", "steps", "PPE mean", "PPE max"
+        "dam break, {t_end} s simulated, {} thread(s), median of {reps} (interleaved)",
+        env_or("SPH_BENCH_THREADS", 1usize)
+    );
+    println!(
+        "{:>9} {:>6} {:>16} {:>17} {:>8} {:>10} {:>8}",
+        "fluid", "solver", "CPU-s per sim s", "wall s per sim s", "steps", "PPE mean", "PPE max"
     );
     for spacing in spacings {
-        let mut rows: Vec<(&str, Vec<f64>, Vec<String>)> = vec![("wcsph", vec![], vec![]), ("isph", vec![], vec![])];
+        type Row<'a> = (&'a str, Vec<f64>, Vec<f64>, Vec<String>);
+        let mut rows: Vec<Row> = vec![("wcsph", vec![], vec![], vec![]), ("isph", vec![], vec![], vec![])];
         for _ in 0..reps {
-            for (solver, cpu, rest) in rows.iter_mut() {
+            for (solver, cpu, wall, rest) in rows.iter_mut() {
                 let out = Command::new(&exe)
                     .env("SPH_BENCH_SIM_CHILD", format!("{spacing},{solver},{t_end}"))
                     .output()
@@ -103,19 +112,21 @@ fn main() {
                     String::from_utf8_lossy(&out.stderr)
                 );
                 cpu.push(fields[0].parse::<f64>().unwrap() / t_end);
+                wall.push(fields[5].parse::<f64>().unwrap() / t_end);
                 *rest = fields[1..].to_vec();
             }
         }
-        for (solver, cpu, rest) in rows {
+        for (solver, cpu, wall, rest) in rows {
             let ppe = if solver == "isph" {
                 (rest[1].as_str(), rest[2].as_str())
             } else {
                 ("", "")
             };
             println!(
-                "{:>9} {solver:>6} {:>16.1} {:>8} {:>10} {:>14}",
+                "{:>9} {solver:>6} {:>16.1} {:>17.1} {:>8} {:>10} {:>8}",
                 rest[3],
                 median(cpu),
+                median(wall),
                 rest[0],
                 ppe.0.parse::<f64>().map(|m| format!("{m:.1}")).unwrap_or_default(),
                 ppe.1

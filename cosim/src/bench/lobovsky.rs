@@ -15,7 +15,7 @@ use std::path::Path;
 use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
 
-use super::metrics::{curve, interpolate};
+use super::curve::{curve, interpolate};
 use crate::compare::read_probe;
 
 /// Water column height H [m], gravity [m/s²] and density [kg/m³] of the experiment.

@@ -3,6 +3,7 @@
 //! (issue 5). Writes `DIR/bench.json` ([`record`]), `DIR/report.md` ([`report`]), `DIR/pareto.svg`
 //! ([`pareto`]); the cases' own outputs go to `DIR/runs/<case>`.
 
+pub mod curve;
 pub mod lobovsky;
 pub mod metrics;
 pub mod pareto;

@@ -16,8 +16,7 @@ use cosim_proto::scene::{ContactAlgorithm, FluidSolver as SceneSolver, Scene};
 use rayon::prelude::*;
 
 use super::contact::{ContactLayer, ContactRow};
-use super::multigrid::{Cycle, Multigrid};
-use super::{bicgstab, ppe, projection, wall_normal, IsphOptions, PpeSource, Preconditioning};
+use super::{ppe, projection, wall_normal, IsphOptions, PpeSource};
 use crate::boundary::repulsion::RANGE;
 use crate::boundary::wall_guard::WallBoxes;
 use crate::corrections::{apd, xsph};
@@ -32,6 +31,7 @@ use crate::setup::{self, FluidSetup};
 mod diagnostics;
 pub use diagnostics::PpeReport;
 mod fluid_solver;
+mod pressure;
 mod restore;
 mod source;
 
@@ -312,33 +312,13 @@ impl IsphSolver {
             &mut b,
         );
         let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
-        // Jacobi scaling: every row to a unit diagonal (the residual of `bicgstab` is then in pressure units).
-        let inv_diag: Vec<f64> = a
-            .diagonal()
-            .iter()
-            .map(|&d| if d != 0.0 { 1.0 / d } else { 1.0 })
-            .collect();
-        a.scale_rows(&inv_diag, &mut b);
-        drop(inv_diag);
         let mut p: Vec<f64> = self.state.p.iter().chain(&self.walls.p).copied().collect();
         for (pi, &f) in p.iter_mut().zip(&free) {
             if f {
                 *pi = 0.0;
             }
         }
-        let (tol, max_iter) = (self.options.tolerance, self.options.max_iterations);
-        let result = match self.options.preconditioner {
-            Preconditioning::Jacobi => bicgstab::solve(&a, &b, &mut p, &mut bicgstab::Identity, tol, max_iter),
-            Preconditioning::Multigrid => {
-                // Aggregates: cells of 2 Δx (`multigrid`)
-                let mut multigrid = Multigrid::build(&a, &self.scratch.x, 2.0 * self.params.dx);
-                let mut m = Cycle {
-                    multigrid: &mut multigrid,
-                    a: &a,
-                };
-                bicgstab::solve(&a, &b, &mut p, &mut m, tol, max_iter)
-            }
-        };
+        let result = self.solve_pressure(&mut a, &mut b, &mut p);
         let n_free = free.iter().filter(|&&f| f).count();
         self.scratch.free = free;
         self.scratch.source = source;
