@@ -19,7 +19,11 @@
 //! dam break, MLS + APD, inviscid, a drop without walls), for checking that an optimisation leaves the results
 //! bit-identical.
 
+mod common;
+
 use std::process::Command;
+
+use common::{cpu_seconds, median};
 use std::time::Instant;
 
 use peak_alloc::PeakAlloc;
@@ -44,23 +48,6 @@ fn peak_rss() -> u64 {
         .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).map(str::to_string))
         .and_then(|l| l.split_whitespace().nth(1).and_then(|kb| kb.parse::<u64>().ok()))
         .map_or(0, |kb| kb * 1024)
-}
-
-/// CPU time of all threads of this process so far [s] (Linux `schedstat`), 0 elsewhere.
-fn cpu_seconds() -> f64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return 0.0;
-    };
-    let ns: u64 = tasks
-        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
-        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
-        .sum();
-    ns as f64 * 1e-9
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn env_list<T: std::str::FromStr>(name: &str, default: &str) -> Vec<T> {

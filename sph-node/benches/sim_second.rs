@@ -10,7 +10,11 @@
 //! CPU seconds are the process's own (`/proc/self/task/*/schedstat`): time spent waiting for a core another program
 //! held is not counted. Nothing is asserted.
 
+mod common;
+
 use std::process::Command;
+
+use common::{cpu_seconds, median};
 
 use sph_node::{FluidSolver, IsphSolver, WcsphSolver};
 
@@ -18,18 +22,6 @@ fn scene(spacing: f64, solver: &str) -> cosim_proto::scene::Scene {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
     let overrides = vec![format!("fluid.spacing={spacing}"), format!("fluid.solver=\"{solver}\"")];
     cosim_proto::scene::parse("dam_break.toml", &text, &overrides).unwrap()
-}
-
-/// CPU time of all threads of this process so far [s] (Linux `schedstat`), 0 elsewhere.
-fn cpu_seconds() -> f64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return 0.0;
-    };
-    let ns: u64 = tasks
-        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
-        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
-        .sum();
-    ns as f64 * 1e-9
 }
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -65,11 +57,6 @@ fn child(spacing: f64, solver: &str, t_end: f64) {
         let (cpu, wall) = (cpu_seconds() - c0, w0.elapsed().as_secs_f64());
         println!("{cpu} {steps} {} {it_max} {n} {wall}", it_sum as f64 / steps as f64);
     });
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn main() {
