@@ -75,8 +75,7 @@ pub fn solve<M: Preconditioner>(
     let scale = if b_norm > 0.0 { b_norm } else { 1.0 };
     // r = b − A x
     let mut r = vec![0.0; n];
-    a.mul_into(x, &mut r);
-    r.par_iter_mut().zip(b.par_iter()).for_each(|(r, b)| *r = b - *r);
+    a.residual_into(b, x, &mut r);
     let mut res = dot(&r, &r).sqrt() / scale;
     if res <= tol {
         return Ok(SolveStats {

@@ -18,6 +18,19 @@ struct Chunk {
     val: Vec<f64>,
 }
 
+impl Chunk {
+    /// Σ_j A_kj x_j over the chunk's row k, in its stored order.
+    #[inline]
+    fn row_dot(&self, k: usize, x: &[f64]) -> f64 {
+        let r = self.start[k] as usize..self.start[k + 1] as usize;
+        self.col[r.clone()]
+            .iter()
+            .zip(&self.val[r])
+            .map(|(&c, &v)| v * x[c as usize])
+            .sum()
+    }
+}
+
 /// The entries of one row being assembled: push them in order, then [`RowSink::finish`].
 pub struct RowSink<'a> {
     chunk: &'a mut Chunk,
@@ -182,13 +195,7 @@ impl SparseRows {
             .zip(&self.chunks)
             .for_each(|((r, f), c)| {
                 for (k, (ri, fi)) in r.iter_mut().zip(f).enumerate() {
-                    let range = c.start[k] as usize..c.start[k + 1] as usize;
-                    *ri = fi
-                        - c.col[range.clone()]
-                            .iter()
-                            .zip(&c.val[range])
-                            .map(|(&c, &v)| v * x[c as usize])
-                            .sum::<f64>();
+                    *ri = fi - c.row_dot(k, x);
                 }
             });
     }
@@ -197,12 +204,7 @@ impl SparseRows {
     pub fn mul_into(&self, x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(ROWS).zip(&self.chunks).for_each(|(y, c)| {
             for (k, yi) in y.iter_mut().enumerate() {
-                let r = c.start[k] as usize..c.start[k + 1] as usize;
-                *yi = c.col[r.clone()]
-                    .iter()
-                    .zip(&c.val[r])
-                    .map(|(&c, &v)| v * x[c as usize])
-                    .sum();
+                *yi = c.row_dot(k, x);
             }
         });
     }
