@@ -277,7 +277,8 @@ impl ContactLayer {
 /// neighbour list; this includes the particles next to the structure that the contact did not correct lately, and
 /// the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
 /// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its free-surface flag
-/// becomes ∇·r (in front of the face plus the half-space) < `threshold`. Distances below −Δx/4 (a particle the
+/// becomes ∇·r (in front of the face plus the half-space) < `threshold`, and its Dirichlet weight follows that ∇·r
+/// ([`super::free_surface::dirichlet_weight`]). Distances below −Δx/4 (a particle the
 /// predictor took into the structure) count as −Δx/4. `out` is left empty when no particle is against a face.
 #[allow(clippy::too_many_arguments)]
 pub fn contact_rows_into(
@@ -289,6 +290,7 @@ pub fn contact_rows_into(
     rho0: f64,
     threshold: f64,
     free: &mut [bool],
+    weight: &mut [f64],
     out: &mut Vec<Option<ContactRow>>,
 ) {
     out.clear();
@@ -330,9 +332,10 @@ pub fn contact_rows_into(
             })
         })
         .collect_into_vec(out);
-    for (f, row) in free.iter_mut().zip(out.iter()) {
+    for ((f, w), row) in free.iter_mut().zip(weight.iter_mut()).zip(out.iter()) {
         if let Some(row) = row {
-            *f = row.div_r < threshold;
+            *w = super::free_surface::dirichlet_weight(row.div_r, threshold);
+            *f = *w >= 1.0;
         }
     }
 }

@@ -77,7 +77,8 @@ pub struct IsphOptions {
     pub max_iterations: usize,
     /// C of Δt = C h / v_max (`DESIGN.md` §4.3, step 6: 0.1–0.25).
     pub courant: f64,
-    /// Particles with ∇·r below this are free-surface particles (2D: 1.5, Lo & Shao 2002).
+    /// Particles with ∇·r below this are free-surface particles (2D: 1.5, Lo & Shao 2002); the PPE rows pass from
+    /// Dirichlet to Poisson over ± [`free_surface::BLEND_2D`] around it ([`free_surface::dirichlet_weight`]).
     pub free_surface_threshold: f64,
 }
 

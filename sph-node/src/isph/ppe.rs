@@ -9,7 +9,9 @@
 //!   Where the support of an interior particle is cut by the void (no particle, fluid or wall, beyond a free
 //!   surface), the part of Σ_j c_ij that the void takes away beyond [`VOID_TOLERANCE`] of the full lattice's is
 //!   added to the diagonal: the void counts as p = 0 ([`full_support_coefficient`], [`fluid_row`]).
-//! * Free-surface fluid particle (∇·r < threshold): p_i = 0 (Dirichlet).
+//! * Free-surface fluid particle (∇·r ≤ threshold − 0.25): p_i = 0 (Dirichlet); within 0.25 of the threshold the row is
+//!   (1 − φ) × the interior row + φ × the Dirichlet row, φ falling from 1 to 0 across the band
+//!   ([`super::free_surface::dirichlet_weight`]).
 //! * Wall particle w (Adami et al. 2012, Eq. (27), a_w = 0): p_w − Σ_f (W_wf/Σ_f W_wf) p_f =
 //!   Σ_f [ρ_f g · r_wf + ρ_f (ũ_f · n)(r_wf · n)/Δt] W_wf / Σ_f W_wf, ũ_f = u*_f − Δt g, n the wall's normal: the
 //!   projection's condition u^{n+1} · n = 0 ([`super::wall_normal`]); a wall particle with no fluid in reach gets
@@ -26,7 +28,9 @@ use crate::particles::{separation, ParticleView};
 /// wall particle with no fluid in reach) through the nonzero entries of its row. A group of rows that does not
 /// (a fluid particle pushed inside a wall, whose only neighbours are wall particles that extrapolate from it alone;
 /// a pocket of fluid cut off from every free surface) is a pure Neumann problem: singular, and with an inconsistent
-/// right-hand side BiCGSTAB diverges. The highest fluid particle (largest −g · x, then the lowest index) of each
+/// right-hand side BiCGSTAB diverges. A fluid row with a Dirichlet weight φ > 0 (`weight`, see
+/// [`super::free_surface::dirichlet_weight`]; empty for none) anchors its group as a Dirichlet row does: its diagonal
+/// exceeds the sum of its off-diagonal entries by φ times itself. The highest fluid particle (largest −g · x, then the lowest index) of each
 /// such group is given p = 0: its row becomes Dirichlet, `b` and `free` are set accordingly.
 ///
 /// Returns the particles anchored this way (in the order they were anchored). Sequential and in index order, so
@@ -35,6 +39,7 @@ pub fn anchor_floating_groups(
     a: &mut SparseRows,
     b: &mut [f64],
     free: &mut [bool],
+    weight: &[f64],
     x: &[[f64; 2]],
     n_fluid: usize,
     gravity: [f64; 2],
@@ -51,6 +56,9 @@ pub fn anchor_floating_groups(
                 *d = false;
             }
         }
+    }
+    for (d, &w) in dirichlet.iter_mut().zip(weight) {
+        *d |= w > 0.0;
     }
     for k in 0..n {
         count[k + 1] += count[k];
@@ -159,6 +167,7 @@ pub fn fluid_row(
     neighbors: &[u32],
     kernel: &CubicSpline,
     free_surface: bool,
+    keep: f64,
     source: f64,
     hydrostatic: Option<([f64; 2], f64)>,
     full: f64,
@@ -186,7 +195,15 @@ pub fn fluid_row(
         // The void as p = 0 beyond the tolerance (see above): consistent with the symmetric gradient of the corrector
         diag += (full - diag - VOID_TOLERANCE * full).max(0.0);
     }
-    row.values_mut()[0] = diag;
+    let values = row.values_mut();
+    values[0] = diag;
+    if keep < 1.0 {
+        // (1 − φ) × the Poisson row + φ × the Dirichlet row diag · p_i = 0 (`free_surface::dirichlet_weight`)
+        for e in &mut values[1..] {
+            *e *= keep;
+        }
+        return keep * rhs;
+    }
     rhs
 }
 
@@ -248,6 +265,7 @@ pub fn assemble(
     gravity: [f64; 2],
     rho0: f64,
     free: &[bool],
+    weight: &[f64],
     contact: &[bool],
     sources: &[f64],
     normals: &[[f64; 2]],
@@ -268,7 +286,20 @@ pub fn assemble(
     a.assemble(view.x.len(), b, bound, |i, row| {
         if i < view.n_fluid {
             let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
-            fluid_row(i, view, list.of(i), kernel, free[i], sources[i], hydrostatic, full, row)
+            // 1 − φ: the share of the Poisson row (`free_surface::dirichlet_weight`; all of it where no weight is given)
+            let keep = 1.0 - weight.get(i).copied().unwrap_or(0.0);
+            fluid_row(
+                i,
+                view,
+                list.of(i),
+                kernel,
+                free[i],
+                keep,
+                sources[i],
+                hydrostatic,
+                full,
+                row,
+            )
         } else {
             let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
             let touch = touch.get(i - view.n_fluid).copied().unwrap_or(0.0);
@@ -313,9 +344,61 @@ mod tests {
             1,
             &mut Vec::new(),
             |_| neighbors.len() + 1,
-            |_, row| fluid_row(0, &view, &neighbors, &kernel, false, 0.0, hydro, full, row),
+            |_, row| fluid_row(0, &view, &neighbors, &kernel, false, 1.0, 0.0, hydro, full, row),
         );
         (a.row(0).1[0], full)
+    }
+
+    #[test]
+    fn a_row_in_the_surface_band_is_the_interior_row_scaled_off_the_diagonal() {
+        // The second row under a flat surface, with a source: the band row keeps the diagonal and scales the
+        // neighbours' entries and the right-hand side by 1 − φ (`free_surface::dirichlet_weight`).
+        let (dx, rho0) = (0.01, 1000.0);
+        let kernel = CubicSpline::new(1.3 * dx);
+        let mut x = vec![[0.0, 0.0]];
+        for iy in -5..=1 {
+            for ix in -5..=5 {
+                if (ix, iy) != (0, 0) {
+                    x.push([ix as f64 * dx, iy as f64 * dx]);
+                }
+            }
+        }
+        let n = x.len();
+        let (v, rho, p, m) = (vec![[0.0; 2]; n], vec![rho0; n], vec![0.0; n], vec![rho0 * dx * dx; n]);
+        let view = ParticleView {
+            x: &x,
+            v: &v,
+            rho: &rho,
+            p: &p,
+            m: &m,
+            n_fluid: n,
+        };
+        let neighbors: Vec<u32> = (1..n as u32)
+            .filter(|&j| separation(x[0], x[j as usize]).1 < kernel.support())
+            .collect();
+        let full = full_support_coefficient(&kernel, dx, rho0);
+        let row = |keep: f64| {
+            let mut a = SparseRows::default();
+            let mut b = Vec::new();
+            a.assemble(
+                1,
+                &mut b,
+                |_| neighbors.len() + 1,
+                |_, row| fluid_row(0, &view, &neighbors, &kernel, false, keep, 250.0, None, full, row),
+            );
+            let (_, values) = a.row(0);
+            (values.to_vec(), b[0])
+        };
+        let (interior, b1) = row(1.0);
+        let (band, b) = row(0.25);
+        assert_eq!(band[0], interior[0]);
+        for (e, e1) in band[1..].iter().zip(&interior[1..]) {
+            assert!((e - 0.25 * e1).abs() <= 1e-15 * e1.abs(), "{e} against 0.25 × {e1}");
+        }
+        assert!(
+            b1 == -250.0 && (b - 0.25 * b1).abs() < 1e-12,
+            "right-hand side {b} against 0.25 × {b1}"
+        );
     }
 
     #[test]
@@ -358,12 +441,12 @@ mod tests {
             [0.0, -0.005],
             [0.0, -0.01],
         ];
-        let pinned = anchor_floating_groups(&mut a, &mut b, &mut free, &x, 5, [0.0, -9.81]);
+        let pinned = anchor_floating_groups(&mut a, &mut b, &mut free, &[], &x, 5, [0.0, -9.81]);
         assert_eq!(pinned, vec![4]);
         assert!(free[4] && !free[3]);
         assert_eq!(b[4], 0.0);
         assert_eq!(a.row(4).1, &[1.0, 0.0]);
         // Anchored groups are left alone.
-        assert!(anchor_floating_groups(&mut a, &mut b, &mut free, &x, 5, [0.0, -9.81]).is_empty());
+        assert!(anchor_floating_groups(&mut a, &mut b, &mut free, &[], &x, 5, [0.0, -9.81]).is_empty());
     }
 }

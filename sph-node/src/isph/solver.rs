@@ -5,7 +5,7 @@
 //! 0. in a coupled run, the contact's corrections since the last step tell which particles lean on a structure
 //!    ([`super::contact`]), and a particle found inside a wall is put back on its face ([`crate::boundary::wall_guard`]);
 //! 1. predictor u* = uⁿ + Δt (g + ν∇²uⁿ), x* = xⁿ + Δt u*;
-//! 2. neighbours at x*; free surface (∇·r < 1.5 → p = 0); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
+//! 2. neighbours at x*; free surface (∇·r ≤ 1.25 → p = 0, Poisson rows from 1.75, blended between); PPE source (∇·u*/Δt or (ρ0 − ρ*)/(ρ0 Δt²));
 //! 3. PPE solved by Jacobi-BiCGSTAB warm-started from the last pressures (fluid and walls);
 //! 4. corrector u^{n+1} = u* − Δt (∇p/ρ)_i at x*; x^{n+1} = xⁿ + Δt (uⁿ + u^{n+1})/2 (+ Δt XSPH of u^{n+1});
 //! 5. APD shift of x^{n+1} (`fluid.apd` > 0, §4.4).
@@ -48,6 +48,7 @@ struct Scratch {
     cells: CellList,
     list: NeighborList,
     free: Vec<bool>,
+    weight: Vec<f64>,
     contact: Vec<Option<ContactRow>>,
     in_contact: Vec<bool>,
     source: Vec<f64>,
@@ -279,6 +280,7 @@ impl IsphSolver {
 
         let Source {
             mut free,
+            weight,
             rows,
             in_contact,
             n_contact,
@@ -300,6 +302,7 @@ impl IsphSolver {
             g,
             self.params.rho0,
             &free,
+            &weight,
             &in_contact,
             &source,
             &self.wall_normals,
@@ -311,7 +314,7 @@ impl IsphSolver {
             &mut a,
             &mut b,
         );
-        let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &self.scratch.x, nf, g);
+        let pinned = ppe::anchor_floating_groups(&mut a, &mut b, &mut free, &weight, &self.scratch.x, nf, g);
         let mut p: Vec<f64> = self.state.p.iter().chain(&self.walls.p).copied().collect();
         for (pi, &f) in p.iter_mut().zip(&free) {
             if f {
@@ -319,8 +322,10 @@ impl IsphSolver {
             }
         }
         let result = self.solve_pressure(&mut a, &mut b, &mut p);
-        let n_free = free.iter().filter(|&&f| f).count();
+        // On the free surface by Lo & Shao's flag (∇·r below the threshold: φ > 1/2), Dirichlet rows or not
+        let n_free = free.iter().zip(&weight).filter(|&(&f, &w)| f || w > 0.5).count();
         self.scratch.free = free;
+        self.scratch.weight = weight;
         self.scratch.source = source;
         self.scratch.contact = rows;
         self.scratch.in_contact = in_contact;

@@ -13,7 +13,8 @@ pub struct PpeReport {
     pub iterations: usize,
     /// Final relative residual (see [`crate::isph::bicgstab`]).
     pub residual: f64,
-    /// Fluid particles given p = 0 as free surface.
+    /// Fluid particles on the free surface: ∇·r below the threshold (Dirichlet weight above 1/2,
+    /// [`crate::isph::free_surface::dirichlet_weight`]) or anchored at p = 0.
     pub free_surface: usize,
     /// Fluid particles whose support a structure face cuts (the first layer against it and the second row; see
     /// [`crate::isph::contact`]).

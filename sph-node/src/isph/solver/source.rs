@@ -11,6 +11,8 @@ use crate::isph::{free_surface, projection, wall_normal, PpeSource};
 pub(super) struct Source {
     /// Free-surface particles (p = 0).
     pub(super) free: Vec<bool>,
+    /// The Dirichlet weight of every fluid particle's PPE row ([`free_surface::dirichlet_weight`]).
+    pub(super) weight: Vec<f64>,
     /// The contact row of each fluid particle against a structure (empty when none is).
     pub(super) rows: Vec<Option<ContactRow>>,
     /// Which fluid particles have a contact row.
@@ -29,12 +31,14 @@ impl IsphSolver {
         let g = self.params.gravity;
         // 2. Free surface and PPE source at x*.
         let mut free = std::mem::take(&mut self.scratch.free);
+        let mut weight = std::mem::take(&mut self.scratch.weight);
         free_surface::free_surface_into(
             &self.view(),
             &self.scratch.list,
             &self.kernel,
             self.options.free_surface_threshold,
             &mut free,
+            &mut weight,
         );
         // Particles against a structure (see `super::contact`): their support, ∇·r and ρ* count the structure's
         // half-space; their rows carry the face's Neumann condition.
@@ -48,6 +52,7 @@ impl IsphSolver {
             self.params.rho0,
             self.options.free_surface_threshold,
             &mut free,
+            &mut weight,
             &mut rows,
         );
         let mut in_contact = std::mem::take(&mut self.scratch.in_contact);
@@ -125,6 +130,7 @@ impl IsphSolver {
         }
         Source {
             free,
+            weight,
             rows,
             in_contact,
             n_contact,
