@@ -283,7 +283,17 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         let mode = if args.connect.is_some() { "client" } else { "peer" };
         announce_external(node, &info.run_id, &connect, mode, args.wait_external, &info.out)?;
     }
-    let mut node_args = vec!["--run".into(), info.run_id.clone(), "--connect".into(), connect];
+    // The nodes wait for the broker's scene as long as the broker had to open its session (their own default is 5 s):
+    // this broker is listening and watched, and on a loaded machine a node's first query through a TLS router took
+    // longer than 5 s (`cosim/tests/access.rs`, `a_run_through_a_tls_router`, beside the rest of the suite).
+    let mut node_args = vec![
+        "--run".into(),
+        info.run_id.clone(),
+        "--connect".into(),
+        connect,
+        "--timeout".into(),
+        LISTEN_TIMEOUT.as_secs().to_string(),
+    ];
     if args.connect.is_some() {
         node_args.push("--client".into());
     }
