@@ -40,9 +40,11 @@ pub const BLEND_2D: f64 = 0.25;
 /// to Poisson in one step and closed a cluster of seven compressed particles off from the surface: its pressure rose
 /// from 3–4 ρgH to 15–19 ρgH for that step, threw the top particle up the wall at 5.6 m/s, and the overshoot left
 /// the cluster at p = 0 the steps after; which particles crossed when decided the sensors' peak, 3.95 to 6.41 ρgH for
-/// changes in the last bits of the PPE's solution. With the band, 2.64 ρgH whatever those bits, and the 10 s still
-/// tank's surface, whose particles kept crossing the threshold, holds a third of the kinetic energy it did
-/// (docs/CORRECTIONS.md, "ISPH pressure: the switch at the free surface").
+/// changes in the last bits of the PPE's solution. With the band, 3.03 and 2.82 ρgH for two such changes, and the
+/// 10 s still tank's surface, whose particles kept crossing the threshold, holds a third of the kinetic energy it
+/// did. A wider band (±0.3) was less sensitive still but let ISPH at 8 × its step run on gaining energy; one on one
+/// side of the threshold only moves the still tank's pressure (docs/CORRECTIONS.md, "The switch at the free
+/// surface").
 #[inline]
 pub fn dirichlet_weight(div_r: f64, threshold: f64) -> f64 {
     let (lo, hi) = (threshold - BLEND_2D, threshold + BLEND_2D);
