@@ -79,30 +79,8 @@ mod tests {
 
     /// ∇·r of the particle at the origin of a square lattice holding rows y = −5 Δx … `top` Δx.
     fn lattice_div_r(top: i32) -> f64 {
-        let (dx, rho0) = (0.01, 1000.0);
-        let kernel = CubicSpline::new(1.3 * dx);
-        let mut x = vec![[0.0, 0.0]];
-        for iy in -5..=top {
-            for ix in -5..=5 {
-                if (ix, iy) != (0, 0) {
-                    x.push([ix as f64 * dx, iy as f64 * dx]);
-                }
-            }
-        }
-        let n = x.len();
-        let (v, rho, p, m) = (vec![[0.0; 2]; n], vec![rho0; n], vec![0.0; n], vec![rho0 * dx * dx; n]);
-        let view = ParticleView {
-            x: &x,
-            v: &v,
-            rho: &rho,
-            p: &p,
-            m: &m,
-            n_fluid: n,
-        };
-        let neighbors: Vec<u32> = (1..n as u32)
-            .filter(|&j| separation(x[0], x[j as usize]).1 < kernel.support())
-            .collect();
-        position_divergence(0, &view, &neighbors, &kernel)
+        let lattice = super::super::lattice::Lattice::new(-5..=top);
+        position_divergence(0, &lattice.view(), &lattice.neighbors, &lattice.kernel)
     }
 
     #[test]

@@ -28,6 +28,8 @@ use serde::{Deserialize, Serialize};
 pub mod bicgstab;
 pub mod contact;
 pub mod free_surface;
+#[cfg(test)]
+mod lattice;
 pub mod multigrid;
 pub mod ppe;
 pub mod projection;

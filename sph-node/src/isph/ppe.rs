@@ -314,37 +314,17 @@ mod tests {
 
     /// Diagonal of the row of the particle at the origin of a lattice with rows `iy` in `rows`, with the void term.
     fn lattice_diagonal(rows: std::ops::RangeInclusive<i32>, hydrostatic: bool) -> (f64, f64) {
-        let (dx, rho0) = (0.01, 1000.0);
-        let kernel = CubicSpline::new(1.3 * dx);
-        let mut x = vec![[0.0, 0.0]];
-        for iy in rows {
-            for ix in -5..=5 {
-                if (ix, iy) != (0, 0) {
-                    x.push([ix as f64 * dx, iy as f64 * dx]);
-                }
-            }
-        }
-        let n = x.len();
-        let (v, rho, p, m) = (vec![[0.0; 2]; n], vec![rho0; n], vec![0.0; n], vec![rho0 * dx * dx; n]);
-        let view = ParticleView {
-            x: &x,
-            v: &v,
-            rho: &rho,
-            p: &p,
-            m: &m,
-            n_fluid: n,
-        };
-        let neighbors: Vec<u32> = (1..n as u32)
-            .filter(|&j| separation(x[0], x[j as usize]).1 < kernel.support())
-            .collect();
-        let full = full_support_coefficient(&kernel, dx, rho0);
+        let lattice = super::super::lattice::Lattice::new(rows);
+        let (view, neighbors, kernel) = (lattice.view(), &lattice.neighbors, &lattice.kernel);
+        let (dx, rho0) = (lattice.dx, lattice.rho0);
+        let full = full_support_coefficient(kernel, dx, rho0);
         let hydro = hydrostatic.then_some(([0.0, -9.81], rho0));
         let mut a = SparseRows::default();
         a.assemble(
             1,
             &mut Vec::new(),
             |_| neighbors.len() + 1,
-            |_, row| fluid_row(0, &view, &neighbors, &kernel, false, 1.0, 0.0, hydro, full, row),
+            |_, row| fluid_row(0, &view, neighbors, kernel, false, 1.0, 0.0, hydro, full, row),
         );
         (a.row(0).1[0], full)
     }
@@ -353,30 +333,10 @@ mod tests {
     fn a_row_in_the_surface_band_is_the_interior_row_scaled_off_the_diagonal() {
         // The second row under a flat surface, with a source: the band row keeps the diagonal and scales the
         // neighbours' entries and the right-hand side by 1 − φ (`free_surface::dirichlet_weight`).
-        let (dx, rho0) = (0.01, 1000.0);
-        let kernel = CubicSpline::new(1.3 * dx);
-        let mut x = vec![[0.0, 0.0]];
-        for iy in -5..=1 {
-            for ix in -5..=5 {
-                if (ix, iy) != (0, 0) {
-                    x.push([ix as f64 * dx, iy as f64 * dx]);
-                }
-            }
-        }
-        let n = x.len();
-        let (v, rho, p, m) = (vec![[0.0; 2]; n], vec![rho0; n], vec![0.0; n], vec![rho0 * dx * dx; n]);
-        let view = ParticleView {
-            x: &x,
-            v: &v,
-            rho: &rho,
-            p: &p,
-            m: &m,
-            n_fluid: n,
-        };
-        let neighbors: Vec<u32> = (1..n as u32)
-            .filter(|&j| separation(x[0], x[j as usize]).1 < kernel.support())
-            .collect();
-        let full = full_support_coefficient(&kernel, dx, rho0);
+        let lattice = super::super::lattice::Lattice::new(-5..=1);
+        let (view, neighbors, kernel) = (lattice.view(), &lattice.neighbors, &lattice.kernel);
+        let (dx, rho0) = (lattice.dx, lattice.rho0);
+        let full = full_support_coefficient(kernel, dx, rho0);
         let row = |keep: f64| {
             let mut a = SparseRows::default();
             let mut b = Vec::new();
@@ -384,7 +344,7 @@ mod tests {
                 1,
                 &mut b,
                 |_| neighbors.len() + 1,
-                |_, row| fluid_row(0, &view, &neighbors, &kernel, false, keep, 250.0, None, full, row),
+                |_, row| fluid_row(0, &view, neighbors, kernel, false, keep, 250.0, None, full, row),
             );
             let (_, values) = a.row(0);
             (values.to_vec(), b[0])
