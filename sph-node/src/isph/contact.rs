@@ -271,13 +271,13 @@ impl ContactLayer {
     }
 }
 
-/// The contact rows of the step at the predicted positions `view.x`, and the free-surface flags of their particles.
+/// The contact rows of the step at the predicted positions `view.x`, and the Dirichlet weights of their particles.
 /// A particle's support is cut by a face when [`ContactLayer::face`] says it is against that face and it is still
 /// within Δx of it, or when it lies within 2h in front of the face of a neighbour that is (the first in the
 /// neighbour list; this includes the particles next to the structure that the contact did not correct lately, and
 /// the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
-/// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its free-surface flag
-/// becomes ∇·r (in front of the face plus the half-space) < `threshold`, and its Dirichlet weight follows that ∇·r
+/// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its Dirichlet weight
+/// (free surface or not) follows ∇·r in front of the face plus the half-space
 /// ([`super::free_surface::dirichlet_weight`]). Distances below −Δx/4 (a particle the
 /// predictor took into the structure) count as −Δx/4. `out` is left empty when no particle is against a face.
 #[allow(clippy::too_many_arguments)]
@@ -289,7 +289,6 @@ pub fn contact_rows_into(
     dx: f64,
     rho0: f64,
     threshold: f64,
-    free: &mut [bool],
     weight: &mut [f64],
     out: &mut Vec<Option<ContactRow>>,
 ) {
@@ -332,10 +331,9 @@ pub fn contact_rows_into(
             })
         })
         .collect_into_vec(out);
-    for ((f, w), row) in free.iter_mut().zip(weight.iter_mut()).zip(out.iter()) {
+    for (w, row) in weight.iter_mut().zip(out.iter()) {
         if let Some(row) = row {
             *w = super::free_surface::dirichlet_weight(row.div_r, threshold);
-            *f = *w >= 1.0;
         }
     }
 }

@@ -51,26 +51,19 @@ pub fn dirichlet_weight(div_r: f64, threshold: f64) -> f64 {
     ((hi - div_r) / (hi - lo)).clamp(0.0, 1.0)
 }
 
-/// The Dirichlet weight φ of every fluid particle into `weight` ([`dirichlet_weight`]) and the free-surface flags
-/// into `free` (true: φ = 1, the row is Dirichlet p = 0).
+/// The Dirichlet weight φ of every fluid particle into `weight` ([`dirichlet_weight`]; φ = 1: on the free surface,
+/// its row is Dirichlet p = 0).
 pub fn free_surface_into(
     view: &ParticleView<'_>,
     list: &NeighborList,
     kernel: &CubicSpline,
     threshold: f64,
-    free: &mut Vec<bool>,
     weight: &mut Vec<f64>,
 ) {
-    // ∇·r first, then the flags and the weights from it
     (0..view.n_fluid)
         .into_par_iter()
-        .map(|i| position_divergence(i, view, list.of(i), kernel))
+        .map(|i| dirichlet_weight(position_divergence(i, view, list.of(i), kernel), threshold))
         .collect_into_vec(weight);
-    free.clear();
-    for w in weight.iter_mut() {
-        *w = dirichlet_weight(*w, threshold);
-    }
-    free.extend(weight.iter().map(|&w| w >= 1.0));
 }
 
 #[cfg(test)]

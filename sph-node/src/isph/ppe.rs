@@ -142,7 +142,8 @@ pub fn laplacian_coefficient(m_j: f64, rho_i: f64, rho_j: f64, r: f64, kernel: &
     -8.0 * m_j / (rs * rs) * r * kernel.dw_dr(r) / (r * r + eta2)
 }
 
-/// Row of fluid particle i and its right-hand side, given `source_i` and the free-surface flag.
+/// Row of fluid particle i and its right-hand side, given `source_i` and `keep` = 1 − φ, the share of the Poisson row
+/// ([`super::free_surface::dirichlet_weight`]; 0: on the free surface, the row is Dirichlet p = 0).
 ///
 /// `hydrostatic = Some((g, ρ0))` for a particle in contact with a structure the fluid does not see (its support is
 /// cut by the structure, [`super::contact`]): the row is written for p − ρ0 g · x,
@@ -166,14 +167,13 @@ pub fn fluid_row(
     view: &ParticleView<'_>,
     neighbors: &[u32],
     kernel: &CubicSpline,
-    free_surface: bool,
     keep: f64,
     source: f64,
     hydrostatic: Option<([f64; 2], f64)>,
     full: f64,
     row: &mut RowSink<'_>,
 ) -> f64 {
-    if free_surface {
+    if keep <= 0.0 {
         // §4.3 step 3: Dirichlet p = 0 on the free surface
         row.push(i as u32, 1.0);
         return 0.0;
@@ -252,7 +252,8 @@ pub fn wall_row(
     (gravity[0] * sum_rho_r[0] + gravity[1] * sum_rho_r[1] + sum_motion) / sum_w
 }
 
-/// Assembles the whole system: `sources` (one per fluid particle), `free` (free-surface flags), `contact`
+/// Assembles the whole system: `sources` (one per fluid particle), `weight` (the Dirichlet weights φ of
+/// [`super::free_surface::dirichlet_weight`], 1 on the free surface; empty for none), `contact`
 /// (particles against a structure, see [`fluid_row`]; empty for none), the walls' `normals` and `touch` distances
 /// (one per wall particle, see [`super::wall_normal`]) and the step `dt` in. `view.v` holds u* of the
 /// fluid. `full`: the diagonal of a full support ([`full_support_coefficient`]) for the void rows of
@@ -264,7 +265,6 @@ pub fn assemble(
     kernel: &CubicSpline,
     gravity: [f64; 2],
     rho0: f64,
-    free: &[bool],
     weight: &[f64],
     contact: &[bool],
     sources: &[f64],
@@ -279,7 +279,7 @@ pub fn assemble(
     // Entries per row at most: a free-surface row has 1; a fluid row the particle and its neighbours; a wall row the
     // wall particle and its fluid neighbours.
     let bound = |i: usize| match i < nf {
-        true if free[i] => 1,
+        true if weight.get(i).is_some_and(|&w| w >= 1.0) => 1,
         true => 1 + list.of(i).len(),
         false => 1 + list.of(i).iter().filter(|&&j| (j as usize) < nf).count(),
     };
@@ -288,18 +288,7 @@ pub fn assemble(
             let hydrostatic = contact.get(i).copied().unwrap_or(false).then_some((gravity, rho0));
             // 1 − φ: the share of the Poisson row (`free_surface::dirichlet_weight`; all of it where no weight is given)
             let keep = 1.0 - weight.get(i).copied().unwrap_or(0.0);
-            fluid_row(
-                i,
-                view,
-                list.of(i),
-                kernel,
-                free[i],
-                keep,
-                sources[i],
-                hydrostatic,
-                full,
-                row,
-            )
+            fluid_row(i, view, list.of(i), kernel, keep, sources[i], hydrostatic, full, row)
         } else {
             let normal = normals.get(i - view.n_fluid).copied().unwrap_or([0.0; 2]);
             let touch = touch.get(i - view.n_fluid).copied().unwrap_or(0.0);
@@ -324,7 +313,7 @@ mod tests {
             1,
             &mut Vec::new(),
             |_| neighbors.len() + 1,
-            |_, row| fluid_row(0, &view, neighbors, kernel, false, 1.0, 0.0, hydro, full, row),
+            |_, row| fluid_row(0, &view, neighbors, kernel, 1.0, 0.0, hydro, full, row),
         );
         (a.row(0).1[0], full)
     }
@@ -344,7 +333,7 @@ mod tests {
                 1,
                 &mut b,
                 |_| neighbors.len() + 1,
-                |_, row| fluid_row(0, &view, neighbors, kernel, false, keep, 250.0, None, full, row),
+                |_, row| fluid_row(0, &view, neighbors, kernel, keep, 250.0, None, full, row),
             );
             let (_, values) = a.row(0);
             (values.to_vec(), b[0])

@@ -301,7 +301,6 @@ impl IsphSolver {
             &self.kernel,
             g,
             self.params.rho0,
-            &free,
             &weight,
             &in_contact,
             &source,

@@ -37,7 +37,6 @@ impl IsphSolver {
             &self.scratch.list,
             &self.kernel,
             self.options.free_surface_threshold,
-            &mut free,
             &mut weight,
         );
         // Particles against a structure (see `super::contact`): their support, ∇·r and ρ* count the structure's
@@ -51,10 +50,12 @@ impl IsphSolver {
             self.params.dx,
             self.params.rho0,
             self.options.free_surface_threshold,
-            &mut free,
             &mut weight,
             &mut rows,
         );
+        // Free surface: the particles whose row is Dirichlet (φ = 1).
+        free.clear();
+        free.extend(weight.iter().map(|&w| w >= 1.0));
         let mut in_contact = std::mem::take(&mut self.scratch.in_contact);
         in_contact.clear();
         in_contact.extend(rows.iter().map(Option::is_some));
