@@ -38,7 +38,6 @@
 
 use rayon::prelude::*;
 
-use crate::corrections::xsph;
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{dot, separation, ParticleView};
@@ -102,58 +101,16 @@ pub fn apd_shift(
         p,
         vol,
         |_, r_ij, r| kernel.grad(r_ij, r),
-        |_, _| (),
+        |_, _, _, _| (),
     )
 }
 
-/// [`apd_shift`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair (i, `neighbors[k]`),
-/// see [`crate::neighbors::ListChunk::grad`]) and `vol[j]` = m_j/ρ_j: the same sum, bit for bit, without
-/// evaluating dW/dr or dividing again.
-#[inline]
-pub fn apd_shift_pairs(
-    i: usize,
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    neighbors: &[u32],
-    grad: &[f64],
-    kernel: &CubicSpline,
-    p: &ApdParams,
-) -> [f64; 2] {
-    let grad_of = |k: usize, r_ij: [f64; 2], _| [grad[k] * r_ij[0], grad[k] * r_ij[1]];
-    apd_shift_with(i, view, neighbors, kernel, p, |j| vol[j], grad_of, |_, _| ())
-}
-
-/// [`apd_shift_pairs`] and the XSPH correction of particle i with coefficient `eps`
-/// ([`crate::corrections::xsph::xsph_correction`]) in one loop over the pairs: both are taken at xⁿ from the same
-/// state, and share the separation and W_ij of each pair. The same two results, bit for bit, as the two passes.
-#[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn apd_xsph_pairs(
-    i: usize,
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    neighbors: &[u32],
-    grad: &[f64],
-    kernel: &CubicSpline,
-    p: &ApdParams,
-    eps: f64,
-) -> ([f64; 2], [f64; 2]) {
-    let grad_of = |k: usize, r_ij: [f64; 2], _| [grad[k] * r_ij[0], grad[k] * r_ij[1]];
-    let mut s = [0.0, 0.0];
-    let xsph = |j: usize, w: f64| {
-        if j < view.n_fluid {
-            xsph::add_term(&mut s, view, i, j, w);
-        }
-    };
-    let shift = apd_shift_with(i, view, neighbors, kernel, p, |j| vol[j], grad_of, xsph);
-    (shift, xsph::finish(s, eps))
-}
-
 /// The shift of [`apd_shift`], with V_j from `vol_of(j)` and ∇_i W_ij of the k-th neighbour from
-/// `grad_of(k, r_ij, r)`; `pair(j, W_ij)` is called for every neighbour j, in order (a pass that shares the loop).
+/// `grad_of(k, r_ij, r)`; `pair(k, j, W_ij, ∇_i W_ij)` is called for every neighbour j = `neighbors[k]`, in order
+/// (a pass that shares the loop: `crate::wcsph::drift_pass`).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn apd_shift_with(
+pub(crate) fn apd_shift_with(
     i: usize,
     view: &ParticleView<'_>,
     neighbors: &[u32],
@@ -161,7 +118,7 @@ fn apd_shift_with(
     p: &ApdParams,
     vol_of: impl Fn(usize) -> f64,
     grad_of: impl Fn(usize, [f64; 2], f64) -> [f64; 2],
-    mut pair: impl FnMut(usize, f64),
+    mut pair: impl FnMut(usize, usize, f64, [f64; 2]),
 ) -> [f64; 2] {
     let xi = view.x[i];
     // Sun et al. 2017, Eq. (7): W(Δx), here at the local spacing Δx_i = sqrt(m_i/ρ_i)
@@ -173,7 +130,7 @@ fn apd_shift_with(
         let (r_ij, r) = separation(xi, view.x[j]);
         let g = grad_of(k, r_ij, r);
         let w = kernel.w(r);
-        pair(j, w);
+        pair(k, j, w, g);
         let v_j = vol_of(j);
         // Lind et al. 2012, Eq. (15): ∇·r = Σ_j V_j (r_j − r_i)·∇_i W_ij (as `position_divergence`)
         div_r -= v_j * dot(r_ij, g);
@@ -232,39 +189,6 @@ pub fn apd_into(
         .collect_into_vec(out);
 }
 
-/// [`apd_into`] from lists with ∇W factors (as built by [`crate::neighbors::SortedCells::build_fluid_lists`], at
-/// the current positions) and `vol[j]` = m_j/ρ_j: the same shifts, bit for bit.
-pub fn apd_pairs_into(
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    list: &NeighborList,
-    kernel: &CubicSpline,
-    params: &ApdParams,
-    out: &mut Vec<[f64; 2]>,
-) {
-    list.map_pairs_into(out, |i, idx, grad| {
-        apd_shift_pairs(i, view, vol, idx, grad, kernel, params)
-    });
-}
-
-/// [`apd_pairs_into`] and [`crate::corrections::xsph::xsph_into`] with coefficient `eps` in one pass
-/// ([`apd_xsph_pairs`]): the shifts into `shift`, the XSPH corrections into `xsph`, bit for bit those of the two.
-#[allow(clippy::too_many_arguments)]
-pub fn apd_xsph_pairs_into(
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    list: &NeighborList,
-    kernel: &CubicSpline,
-    params: &ApdParams,
-    eps: f64,
-    shift: &mut Vec<[f64; 2]>,
-    xsph: &mut Vec<[f64; 2]>,
-) {
-    list.map_pairs_into2(shift, xsph, |i, idx, grad| {
-        apd_xsph_pairs(i, view, vol, idx, grad, kernel, params, eps)
-    });
-}
-
 /// Density change of fluid particle i for the shifts `shift` (all fluid particles; walls do not move), at the
 /// unshifted positions: the continuity equation, Eq. (9), with the shift as the displacement,
 /// δρ_i = Σ_j m_j (δr_i − δr_j)·∇_i W_ij, so that ρ follows the particle number density as it does for the drift
@@ -284,7 +208,7 @@ pub fn shift_density_change(
     })
 }
 
-/// [`shift_density_change`] with the ∇W factors of the pairs precomputed (`grad[k]`, as for [`apd_shift_pairs`]):
+/// [`shift_density_change`] with the ∇W factors of the pairs precomputed (`grad[k]`: ∇W factor of pair (i, `neighbors[k]`), see [`crate::neighbors::ListChunk::grad`]):
 /// the same sum, bit for bit, without a square root or dW/dr per pair.
 #[inline]
 pub fn shift_density_change_pairs(
@@ -335,7 +259,7 @@ pub fn shift_density_change_into(
         .collect_into_vec(out);
 }
 
-/// [`shift_density_change_into`] from lists with ∇W factors (as [`apd_pairs_into`]): the same changes, bit for bit.
+/// [`shift_density_change_into`] from lists with ∇W factors (as built by [`crate::neighbors::SortedCells::build_fluid_lists`]): the same changes, bit for bit.
 pub fn shift_density_change_pairs_into(
     view: &ParticleView<'_>,
     list: &NeighborList,

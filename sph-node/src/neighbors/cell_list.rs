@@ -317,6 +317,42 @@ impl NeighborList {
         });
     }
 
+    /// [`NeighborList::build`], and `out[i] = f(i, neighbours of i, their ∇W factors)` for each particle as soon as
+    /// its list is built (while its pairs are in the cache): the lists and the values of a build followed by
+    /// [`NeighborList::map_pairs_into`], in one pass.
+    pub fn build_and_map<T, G, F>(&mut self, n: usize, gather: G, out: &mut Vec<T>, f: F)
+    where
+        T: Copy + Default + Send,
+        G: Fn(usize, &mut ListChunk) + Sync,
+        F: Fn(usize, &[u32], &[f64]) -> T + Sync,
+    {
+        self.n = n;
+        let n_chunks = n.div_ceil(CHUNK);
+        self.chunks.truncate(n_chunks);
+        self.chunks.resize_with(n_chunks, ListChunk::default);
+        out.resize(n, T::default()); // every entry is overwritten
+        self.chunks
+            .par_iter_mut()
+            .zip(out.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (chunk, out))| {
+                let first = c * CHUNK;
+                let last = (first + CHUNK).min(n);
+                chunk.clear(first, last - first);
+                for (i, o) in (first..last).zip(out.iter_mut()) {
+                    gather(i, chunk);
+                    chunk.close_particle();
+                    let r = chunk.range(i - first);
+                    let g = if chunk.kernel_written {
+                        &chunk.grad[r.clone()]
+                    } else {
+                        &[][..]
+                    };
+                    *o = f(i, &chunk.idx[r], g);
+                }
+            });
+    }
+
     /// `out[i] = f(i, neighbours of i, their ∇W factors)` for every particle with a list, in parallel over the
     /// chunks (each value depends on its own particle only, so the result does not depend on the thread count).
     /// The factors are empty when the builder did not evaluate the kernel.
@@ -338,24 +374,27 @@ impl NeighborList {
             });
     }
 
-    /// [`NeighborList::map_pairs_into`] for a pass with two results per particle: `(a[i], b[i]) = f(i, …)`.
-    pub fn map_pairs_into2<A, B, F>(&self, a: &mut Vec<A>, b: &mut Vec<B>, f: F)
+    /// [`NeighborList::map_pairs_into`] for a pass with three results per particle: `(a[i], b[i], c[i]) = f(i, …)`.
+    pub fn map_pairs_into3<A, B, C, F>(&self, a: &mut Vec<A>, b: &mut Vec<B>, c: &mut Vec<C>, f: F)
     where
         A: Copy + Default + Send,
         B: Copy + Default + Send,
-        F: Fn(usize, &[u32], &[f64]) -> (A, B) + Sync,
+        C: Copy + Default + Send,
+        F: Fn(usize, &[u32], &[f64]) -> (A, B, C) + Sync,
     {
         a.resize(self.n, A::default()); // every entry is overwritten
         b.resize(self.n, B::default());
+        c.resize(self.n, C::default());
         a.par_chunks_mut(CHUNK)
             .zip(b.par_chunks_mut(CHUNK))
+            .zip(c.par_chunks_mut(CHUNK))
             .zip(self.chunks.par_iter())
-            .for_each(|((a, b), chunk)| {
+            .for_each(|(((a, b), c), chunk)| {
                 let grad = chunk.grad();
-                for (k, (a, b)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+                for (k, ((a, b), c)) in a.iter_mut().zip(b.iter_mut()).zip(c.iter_mut()).enumerate() {
                     let r = chunk.range(k);
                     let g = if grad.is_empty() { &[][..] } else { &grad[r.clone()] };
-                    (*a, *b) = f(chunk.first() + k, &chunk.idx[r], g);
+                    (*a, *b, *c) = f(chunk.first() + k, &chunk.idx[r], g);
                 }
             });
     }

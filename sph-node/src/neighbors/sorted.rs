@@ -240,6 +240,28 @@ impl SortedCells {
         list.build(n_fluid, |i, chunk| self.gather_fluid(x, n_fluid, kernel, i, chunk));
     }
 
+    /// [`SortedCells::build_fluid_lists`], and `out[i] = f(i, neighbours of i, their ∇W factors)` for each fluid
+    /// particle as soon as its list is built ([`NeighborList::build_and_map`]).
+    pub fn build_fluid_lists_and_map<T, F>(
+        &self,
+        x: &[[f64; 2]],
+        n_fluid: usize,
+        kernel: &CubicSpline,
+        list: &mut NeighborList,
+        out: &mut Vec<T>,
+        f: F,
+    ) where
+        T: Copy + Default + Send,
+        F: Fn(usize, &[u32], &[f64]) -> T + Sync,
+    {
+        list.build_and_map(
+            n_fluid,
+            |i, chunk| self.gather_fluid(x, n_fluid, kernel, i, chunk),
+            out,
+            f,
+        );
+    }
+
     /// Appends the neighbours of fluid slot i, with their ∇W factors, to `chunk`.
     #[inline]
     fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {

@@ -6,6 +6,7 @@
 pub mod artificial_viscosity;
 pub mod continuity;
 pub mod density_diffusion;
+pub mod drift_pass;
 pub mod laminar_viscosity;
 pub mod momentum;
 pub mod params;

@@ -20,12 +20,17 @@
 //! the drift, x^{n+1} = xⁿ + Δt (v^{n+½} + XSPH) + δr (as DualSPHysics applies its shifting with the position
 //! update). Shifting x^{n+1} after the drift, as the solver did before, needed a second search and sort per step:
 //! a sixth of a step's time on the 20,000-particle dam break (docs/PERFORMANCE.md).
+//!
+//! Three passes over the pairs per step besides the search (issue 20): at xⁿ the density rate, XSPH and the APD
+//! shift together (`drift_pass.rs`); at x^{n+1}, the density rate with the shift's density change, each particle's
+//! taken as soon as the search has built its list (`passes.rs`, `rebuild_neighbors_and_density`); then the
+//! momentum equation.
 
 use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
 use rayon::prelude::*;
 
 use crate::boundary::wall_guard::WallBoxes;
-use crate::corrections::{apd, density_filter, mls, xsph};
+use crate::corrections::{apd, density_filter, mls};
 use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::integrator;
@@ -35,6 +40,7 @@ use crate::params::SphParams;
 use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup::{self, FluidSetup};
 use crate::time_step;
+use crate::wcsph::drift_pass::{self, DriftPass};
 use crate::wcsph::params::WcsphParams;
 use crate::wcsph::sorted::{update_vol, Sorted};
 use crate::wcsph::DensityDiffusion;
@@ -327,17 +333,15 @@ impl WcsphSolver {
         }
         // Kick.
         integrator::half_kick(&mut self.sorted.v[..nf], &self.sorted.accel, dt);
-        // Density drifts with the positions: its rate uses v^{n+½} at both ends of the step (trapezoid in x).
-        // A rate kept from the previous step (v^{n−½}) would make the acoustic modes grow.
-        self.density_half_kick(dt);
-        // Drift (XSPH at the old positions with the half-step velocities), and APD (§4.4; Xu et al. 2009,
-        // Eq. (35)) at xⁿ, with the neighbours of the last search; the shift joins the drift below, so that the
-        // positions are searched once a step (DualSPHysics applies its shifting with the position update in the
-        // same way). Both from the same state: with both on, one pass over the pairs computes the two.
+        // One pass over the pairs at xⁿ with v^{n+½} (drift_pass.rs): the density rate (its half kick below; the
+        // rate uses v^{n+½} at both ends of the step, a trapezoid in x: a rate kept from the previous step,
+        // v^{n−½}, would make the acoustic modes grow), XSPH for the drift, and APD (§4.4; Sun et al. 2017) with the
+        // neighbours of the last search. The shift joins the drift, so that the positions are searched once a step
+        // (DualSPHysics applies its shifting with the position update in the same way); its density change is
+        // taken with the rate at the new positions.
+        let mut rate = std::mem::take(&mut self.scratch.per1);
         let mut corr = std::mem::take(&mut self.scratch.per2);
-        corr.clear();
         let mut shift = std::mem::take(&mut self.scratch.shift);
-        shift.clear();
         let v_max = if self.wcsph.apd > 0.0 {
             max_norm(&self.sorted.v[..nf])
         } else {
@@ -348,20 +352,21 @@ impl WcsphSolver {
             v_max,
             dt,
         });
-        let (view, vol, list, kernel) = (self.view(), &self.sorted.vol, &self.scratch.list, &self.kernel);
-        match (self.params.xsph > 0.0, &apd_params) {
-            (true, Some(a)) => {
-                apd::apd_xsph_pairs_into(&view, vol, list, kernel, a, self.params.xsph, &mut shift, &mut corr)
-            }
-            (true, None) => xsph::xsph_into(&view, list, kernel, self.params.xsph, &mut corr),
-            (false, Some(a)) => apd::apd_pairs_into(&view, vol, list, kernel, a, &mut shift),
-            (false, None) => {}
-        }
-        if apd_params.is_some() {
-            // ρ follows the shift as the continuity equation would (see `apd::shift_density_change`).
-            self.density_follows_shift(&shift);
-        }
+        let diffusion = self.density_diffusion();
+        let view = self.view();
+        let pass = DriftPass {
+            view: &view,
+            vol: &self.sorted.vol,
+            kernel: &self.kernel,
+            diffusion: diffusion.as_ref(),
+            apd: apd_params.as_ref(),
+            xsph: self.params.xsph,
+        };
+        drift_pass::drift_pass_into(&pass, &self.scratch.list, &mut rate, &mut shift, &mut corr);
         let s = &mut self.sorted;
+        integrator::half_kick_density(&mut s.rho[..nf], &rate, dt);
+        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
+        self.scratch.per1 = rate;
         if !self.scratch.edited_x.is_empty() {
             // Positions edited through `state_mut` since the last step: the drift starts from them.
             s.x[..nf].copy_from_slice(&self.scratch.edited_x);
@@ -375,9 +380,9 @@ impl WcsphSolver {
         self.scratch.shift = shift;
         let pushes = self.push_out_of_walls();
         self.check(step_no)?;
-        self.rebuild_neighbors();
-        // Rates at the new positions.
-        self.density_half_kick(dt);
+        // The search at the new positions, and with it the density's half kick there (its rate at the new
+        // positions with v^{n+½}), with the density change of the shift (`apd::shift_density_change`).
+        self.rebuild_neighbors_and_density(dt);
         if let Some(n) = self.wcsph.shepard_interval {
             if step_no % u64::from(n.max(1)) == 0 {
                 let mut filtered = std::mem::take(&mut self.scratch.per1);

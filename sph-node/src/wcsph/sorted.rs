@@ -113,3 +113,47 @@ pub(super) fn permute<T: Copy + Default + Send + Sync>(a: &mut Vec<T>, spare: &m
     spare[nf..].copy_from_slice(&a[nf..]);
     std::mem::swap(a, spare);
 }
+
+/// `a[k] = a_old[src[k]]` for every k of `a` in place, following the cycles of the permutation; `src` is spent: its
+/// entries are marked `u32::MAX` as they are done. Serial, with no spare of `a`'s size (the permutation of a
+/// buffer that is read once after it).
+pub(super) fn permute_spending<T: Copy>(a: &mut [T], src: &mut [u32]) {
+    const DONE: u32 = u32::MAX;
+    for start in 0..a.len() {
+        if src[start] == DONE {
+            continue;
+        }
+        let first = a[start];
+        let mut k = start;
+        loop {
+            let from = src[k] as usize;
+            src[k] = DONE;
+            if from == start {
+                a[k] = first;
+                break;
+            }
+            a[k] = a[from];
+            k = from;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The in-place permutation gives what the one with a spare gives, on a permutation with several cycles and
+    /// fixed points.
+    #[test]
+    fn permuting_in_place_equals_permuting_with_a_spare() {
+        let src: Vec<u32> = vec![3, 0, 2, 5, 1, 4, 7, 6, 8];
+        let a: Vec<[f64; 2]> = (0..src.len()).map(|k| [k as f64, -(k as f64)]).collect();
+        let (mut with_spare, mut spare) = (a.clone(), Vec::new());
+        permute(&mut with_spare, &mut spare, &src);
+        let (mut in_place, mut spent) = (a, src.clone());
+        permute_spending(&mut in_place, &mut spent);
+        assert_eq!(in_place, with_spare);
+        assert_eq!(with_spare[0], [3.0, -3.0]);
+        assert!(spent.iter().all(|&s| s == u32::MAX));
+    }
+}

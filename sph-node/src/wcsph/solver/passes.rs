@@ -8,8 +8,7 @@ use super::WcsphSolver;
 use crate::boundary::adami;
 use crate::boundary::repulsion::Repulsion;
 use crate::corrections::apd;
-use crate::integrator;
-use crate::wcsph::sorted::{permute, update_vol};
+use crate::wcsph::sorted::{permute, permute_spending, update_vol};
 use crate::wcsph::{continuity, momentum, MomentumParams};
 
 impl WcsphSolver {
@@ -46,19 +45,6 @@ impl WcsphSolver {
         apd::shift_density_change_pairs_into(&self.view(), &self.scratch.list, shift, &mut drho);
         let s = &mut self.sorted;
         s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
-        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
-        self.scratch.per1 = drho;
-    }
-
-    /// ρ += ½ Δt Dρ/Dt at the current positions and velocities (Eq. (9), with the δ-SPH diffusion when on).
-    pub(super) fn density_half_kick(&mut self, dt: f64) {
-        let nf = self.state.len();
-        let mut drho = std::mem::take(&mut self.scratch.per1);
-        let diffusion = self.density_diffusion();
-        let (view, vol, list) = (self.view(), &self.sorted.vol, &self.scratch.list);
-        continuity::density_rates_into(&view, vol, list, diffusion.as_ref(), &mut drho);
-        let s = &mut self.sorted;
-        integrator::half_kick_density(&mut s.rho[..nf], &drho, dt);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
         self.scratch.per1 = drho;
     }
@@ -138,6 +124,46 @@ impl WcsphSolver {
     /// Re-sorts the fluid by cell for the current positions and rebuilds the neighbour lists.
     pub(super) fn rebuild_neighbors(&mut self) {
         let nf = self.state.len();
+        self.resort();
+        let s = &self.sorted;
+        let sc = &mut self.scratch;
+        sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
+    }
+
+    /// [`WcsphSolver::rebuild_neighbors`] after the drift, with the density's half kick at the new positions
+    /// taken in the same pass, each particle's as soon as its list is built: ρ += ½ Δt Dρ/Dt (Eq. (9), with the
+    /// δ-SPH diffusion when on), plus the density change of the drift's APD shift (`Scratch::shift`, when the
+    /// step has one; [`continuity::density_increment`]). The volumes follow.
+    pub(super) fn rebuild_neighbors_and_density(&mut self, dt: f64) {
+        let nf = self.state.len();
+        self.resort();
+        let diffusion = self.density_diffusion();
+        let s = &self.sorted;
+        let sc = &mut self.scratch;
+        let (view, vol, kernel) = (s.view(nf), &s.vol, &self.kernel);
+        let (shift, mut drho) = (&sc.shift, std::mem::take(&mut sc.per1));
+        let h = 0.5 * dt;
+        if shift.is_empty() {
+            sc.cells
+                .build_fluid_lists_and_map(&s.x, nf, kernel, &mut sc.list, &mut drho, |i, idx, grad| {
+                    h * continuity::density_rate(i, &view, vol, idx, grad, diffusion.as_ref())
+                });
+        } else {
+            sc.cells
+                .build_fluid_lists_and_map(&s.x, nf, kernel, &mut sc.list, &mut drho, |i, idx, grad| {
+                    continuity::density_increment(i, &view, vol, idx, grad, diffusion.as_ref(), shift, dt)
+                });
+        }
+        let s = &mut self.sorted;
+        s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
+        update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
+        self.scratch.per1 = drho;
+        self.scratch.shift.clear();
+    }
+
+    /// Re-sorts the fluid (and the drift's APD shift, when there is one) by cell for the current positions.
+    fn resort(&mut self) {
+        let nf = self.state.len();
         let s = &mut self.sorted;
         let sc = &mut self.scratch;
         sc.cells.sort(
@@ -155,6 +181,10 @@ impl WcsphSolver {
         for a in [&mut s.rho, &mut s.p, &mut s.m, &mut s.vol] {
             permute(a, &mut sc.per1, src);
         }
-        sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
+        if !sc.shift.is_empty() {
+            // The drift's APD shift, for its density change at the new positions: in place, so that no spare of
+            // its size is held for it (`src` is spent doing so; nothing reads it before the next sort).
+            permute_spending(&mut sc.shift, &mut sc.src);
+        }
     }
 }

@@ -4,9 +4,10 @@ use super::*;
 use crate::boundary::adami;
 use crate::boundary::adami::wall_pressure;
 use crate::boundary::repulsion::Repulsion;
-use crate::corrections::xsph::xsph_correction;
+use crate::corrections::xsph::{self, xsph_correction};
 use crate::neighbors::CellList;
 use crate::particles::separation;
+use crate::wcsph::drift_pass::{self, DriftPass};
 use crate::wcsph::momentum::Pairs;
 use crate::wcsph::{continuity, momentum, MomentumParams};
 
@@ -127,29 +128,51 @@ fn fast_passes_equal_the_reference_gathers() {
         .map(|i| xsph_correction(i, &view, reference.of(i), &kernel, 0.5))
         .collect();
     assert_eq!(bits(&xsph), bits(&expected));
-    // APD and XSPH in one pass: both results, bit for bit those of the separate passes.
+    // The drift pass (rate, APD, XSPH in one loop) and the density increment with the shift after it: every
+    // result, bit for bit those of the separate gathers, for each combination of APD and XSPH.
     let ap = apd::ApdParams {
         beta: 0.04,
         v_max: 1.0,
         dt: 1e-4,
     };
-    let (mut shift, mut both) = (Vec::new(), Vec::new());
-    apd::apd_xsph_pairs_into(
-        &view,
-        &solver.sorted.vol,
-        list,
-        &kernel,
-        &ap,
-        0.5,
-        &mut shift,
-        &mut both,
-    );
     let alone: Vec<_> = (0..nf)
         .map(|i| apd::apd_shift(i, &view, reference.of(i), &kernel, &ap))
         .collect();
     assert!(alone.iter().any(|d| d[0] != 0.0));
-    assert_eq!(bits(&shift), bits(&alone));
-    assert_eq!(bits(&both), bits(&expected));
+    for (apd_on, eps) in [(true, 0.5), (true, 0.0), (false, 0.5), (false, 0.0)] {
+        let pass = DriftPass {
+            view: &view,
+            vol: &solver.sorted.vol,
+            kernel: &kernel,
+            diffusion: None,
+            apd: apd_on.then_some(&ap),
+            xsph: eps,
+        };
+        let (mut rate, mut shift, mut corr) = (Vec::new(), Vec::new(), Vec::new());
+        drift_pass::drift_pass_into(&pass, list, &mut rate, &mut shift, &mut corr);
+        assert_eq!(
+            rate.iter().map(|d| d.to_bits()).collect::<Vec<_>>(),
+            drho.iter().map(|d| d.to_bits()).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            bits(&shift),
+            if apd_on { bits(&alone) } else { vec![] },
+            "APD {apd_on}, XSPH {eps}"
+        );
+        assert_eq!(
+            bits(&corr),
+            if eps > 0.0 { bits(&expected) } else { vec![] },
+            "APD {apd_on}, XSPH {eps}"
+        );
+    }
+    let dt = 1e-4;
+    let mut inc = Vec::new();
+    continuity::density_increments_into(&view, &solver.sorted.vol, list, None, &alone, dt, &mut inc);
+    for (i, d) in inc.iter().enumerate() {
+        let rate = density_rate(i, &view, &vol, reference.of(i), &kernel);
+        let moved = apd::shift_density_change(i, &view, reference.of(i), &kernel, &alone);
+        assert_eq!(d.to_bits(), (0.5 * dt * rate + moved).to_bits(), "slot {i}");
+    }
     let mut wall = Vec::new();
     let g = solver.params.gravity;
     adami::wall_pressures_sorted_into(&view, &solver.scratch.cells, &kernel, g, &solver.eos, &mut wall);
@@ -362,10 +385,10 @@ impl Reference {
             self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
         }
         integrator::half_kick(&mut self.state.v, &self.accel, dt);
-        self.continuity(dt);
+        // XSPH and APD at xⁿ with ρⁿ, before the density's half kick (drift_pass.rs).
+        self.sync();
         let mut corr = Vec::new();
         if self.params.xsph > 0.0 {
-            self.sync();
             let view = self.view();
             corr = (0..view.n_fluid)
                 .map(|i| xsph_correction(i, &view, self.list.of(i), &self.kernel, self.params.xsph))
@@ -375,24 +398,35 @@ impl Reference {
         if self.wcsph.apd > 0.0 {
             let v_max = self.state.v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
             if v_max > 0.0 {
-                self.sync();
                 let ap = apd::ApdParams {
                     beta: self.wcsph.apd,
                     v_max,
                     dt,
                 };
-                let mut drho = Vec::new();
                 apd::apd_into(&self.view(), &self.list, &self.kernel, &ap, &mut shift);
-                apd::shift_density_change_into(&self.view(), &self.list, &self.kernel, &shift, &mut drho);
-                self.state.rho.iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
             }
         }
+        self.continuity(dt);
         integrator::drift(&mut self.state.x, &self.state.v, &corr, dt);
         if !shift.is_empty() {
             integrator::drift(&mut self.state.x, &shift, &[], 1.0);
         }
         self.rebuild();
-        self.continuity(dt);
+        if shift.is_empty() {
+            self.continuity(dt);
+        } else {
+            // The rate at the new positions with the shift's density change, added together.
+            self.sync();
+            let view = self.view();
+            let vol = volumes(&view);
+            let inc: Vec<f64> = (0..view.n_fluid)
+                .map(|i| {
+                    let rate = density_rate(i, &view, &vol, self.list.of(i), &self.kernel);
+                    0.5 * dt * rate + apd::shift_density_change(i, &view, self.list.of(i), &self.kernel, &shift)
+                })
+                .collect();
+            self.state.rho.iter_mut().zip(&inc).for_each(|(r, d)| *r += d);
+        }
         if let Some(n) = self.wcsph.shepard_interval {
             if step_no % u64::from(n.max(1)) == 0 {
                 self.sync();
