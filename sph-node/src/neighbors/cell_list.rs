@@ -302,19 +302,8 @@ impl NeighborList {
     where
         F: Fn(usize, &mut ListChunk) + Sync,
     {
-        self.n = n;
-        let n_chunks = n.div_ceil(CHUNK);
-        self.chunks.truncate(n_chunks);
-        self.chunks.resize_with(n_chunks, ListChunk::default);
-        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            let first = c * CHUNK;
-            let last = (first + CHUNK).min(n);
-            chunk.clear(first, last - first);
-            for i in first..last {
-                gather(i, chunk);
-                chunk.close_particle();
-            }
-        });
+        // Values of `()`: no memory, nothing computed.
+        self.build_and_map(n, gather, &mut Vec::new(), |_, _, _| ());
     }
 
     /// [`NeighborList::build`], and `out[i] = f(i, neighbours of i, their ∇W factors)` for each particle as soon as
