@@ -237,7 +237,8 @@ impl SortedCells {
     /// walls), each with the ∇W factors of its pairs ([`ListChunk::grad`]);
     /// neighbours are the particles closer than `kernel.support()`, in the order of the module documentation.
     pub fn build_fluid_lists(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, list: &mut NeighborList) {
-        list.build(n_fluid, |i, chunk| self.gather_fluid(x, n_fluid, kernel, i, chunk));
+        // Values of `()`: no memory, nothing computed.
+        self.build_fluid_lists_and_map(x, n_fluid, kernel, list, &mut Vec::new(), |_, _, _| ());
     }
 
     /// [`SortedCells::build_fluid_lists`], and `out[i] = f(i, neighbours of i, their ∇W factors)` for each fluid

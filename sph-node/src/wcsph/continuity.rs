@@ -1,7 +1,6 @@
 //! Continuity equation, Eq. (9) of Long et al. 2016: Dρ_i/Dt = ρ_i Σ_j (m_j/ρ_j) (v_i − v_j) · ∇_i W_ij.
 
 use super::density_diffusion::DensityDiffusion;
-use crate::neighbors::NeighborList;
 use crate::particles::{dot, ParticleView};
 
 /// Dρ_i/Dt of fluid particle i (wall neighbours included, with their zero velocity) over its neighbours with the
@@ -78,34 +77,4 @@ fn rate_and_shift<const SHIFT: bool>(
         None => rho_i * sum,                    // Eq. (9), Long et al. 2016
     };
     (rate, moved)
-}
-
-/// Dρ/Dt of every fluid particle into `out` (a parallel gather) from lists with ∇W factors (as built by
-/// [`crate::neighbors::SortedCells::build_fluid_lists`]); `vol[j]` = m_j/ρ_j; with the δ-SPH term when `diffusion`
-/// is given.
-pub fn density_rates_into(
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    list: &NeighborList,
-    diffusion: Option<&DensityDiffusion>,
-    out: &mut Vec<f64>,
-) {
-    list.map_pairs_into(out, |i, idx, grad| density_rate(i, view, vol, idx, grad, diffusion));
-}
-
-/// [`density_increment`] of every fluid particle into `out` (a parallel gather), for the shifts `shift` (in the
-/// slots of the lists) and the step `dt`.
-#[allow(clippy::too_many_arguments)]
-pub fn density_increments_into(
-    view: &ParticleView<'_>,
-    vol: &[f64],
-    list: &NeighborList,
-    diffusion: Option<&DensityDiffusion>,
-    shift: &[[f64; 2]],
-    dt: f64,
-    out: &mut Vec<f64>,
-) {
-    list.map_pairs_into(out, |i, idx, grad| {
-        density_increment(i, view, vol, idx, grad, diffusion, shift, dt)
-    });
 }

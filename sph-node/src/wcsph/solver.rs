@@ -67,8 +67,8 @@ struct Scratch {
     per1: Vec<f64>,
     /// A vector per particle, likewise: the XSPH correction, the spare of the re-sort.
     per2: Vec<[f64; 2]>,
-    /// The APD shift of each fluid particle (in use with the XSPH correction, for the same drift); empty when the
-    /// step has none.
+    /// The APD shift of each fluid particle, from the drift pass until its density change is taken after the search
+    /// (`rebuild_neighbors_and_density`, which empties it); empty when the step has none.
     shift: Vec<[f64; 2]>,
     wall: Vec<(f64, f64)>,
     /// Positions (slot order) edited through `state_mut`, for the next drift; empty when none.

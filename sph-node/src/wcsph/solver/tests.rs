@@ -105,7 +105,10 @@ fn fast_passes_equal_the_reference_gathers() {
         assert_eq!(list.of(i), reference.of(i), "neighbours of slot {i}");
     }
     let mut drho = Vec::new();
-    continuity::density_rates_into(&view, &solver.sorted.vol, list, None, &mut drho);
+    let fast_vol = &solver.sorted.vol;
+    list.map_pairs_into(&mut drho, |i, idx, grad| {
+        continuity::density_rate(i, &view, fast_vol, idx, grad, None)
+    });
     for (i, d) in drho.iter().enumerate() {
         assert_eq!(
             d.to_bits(),
@@ -170,7 +173,9 @@ fn fast_passes_equal_the_reference_gathers() {
     }
     let dt = 1e-4;
     let mut inc = Vec::new();
-    continuity::density_increments_into(&view, &solver.sorted.vol, list, None, &alone, dt, &mut inc);
+    list.map_pairs_into(&mut inc, |i, idx, grad| {
+        continuity::density_increment(i, &view, fast_vol, idx, grad, None, &alone, dt)
+    });
     for (i, d) in inc.iter().enumerate() {
         let rate = density_rate(i, &view, &vol, reference.of(i), &kernel);
         let moved = apd::shift_density_change(i, &view, reference.of(i), &kernel, &alone);
