@@ -7,6 +7,10 @@ with the criteria of issue 16 and cosim/tests/lobovsky.rs, on the data's own tim
   RMS           of p*_sim - p*_data (the data interpolated at the sample times) for t* in [3, 7] (bound: 0.25)
   min           the lowest p* (bound: >= -0.5)
   zeros         samples of exactly 0 from 0.1 t* after the first impact on (the sensors stay under water; bound: none)
+  impulse       the first impact's pressure impulse, the integral of p* dt* from 0.05 t* before it to 0.5 t* after it,
+                each series from its own first impact, against the data's (not bounded: the same impulse under a
+                taller peak is a shorter pulse, as WCSPH's acoustic rho c0 u is)
+  mean          the mean of p*_sim - p*_data over t* in [3, 7] (the part of the RMS that is a bias, not noise)
 
 and, where the run has them (`level_H1` ... `level_H4`), the water-level gauges against the recorded levels:
   the RMS of (level_sim - level_data)/H over the run's samples in the data's time range, and the mean difference.
@@ -46,19 +50,26 @@ def first_impact(s):
     return next(t for t, p in s if t > 1.0 and p >= 0.1)
 
 
+def impulse(s, t1):
+    a, b = t1 - 0.05, t1 + 0.5
+    return sum(0.5 * (p0 + p1) * (u1 - u0) for (u0, p0), (u1, p1) in zip(s, s[1:]) if u0 >= a and u1 <= b)
+
+
 def score(sim, ref):
-    t1 = first_impact(sim)
+    t1, t1d = first_impact(sim), first_impact(ref)
     peak = max(p for t, p in sim if t <= t1 + 0.5)
     diffs = [p - at(ref, t) for t, p in sim if 3.0 <= t <= 7.0]
     rms = math.sqrt(sum(d * d for d in diffs) / len(diffs)) if diffs else float("nan")
+    mean = sum(diffs) / len(diffs) if diffs else float("nan")
     zeros = sum(1 for t, p in sim if t > t1 + 0.1 and p == 0.0)
-    return t1, first_impact(ref), peak, max(p for _, p in ref), rms, min(p for _, p in sim), zeros
+    return (t1, t1d, peak, max(p for _, p in ref), rms, min(p for _, p in sim), zeros,
+            impulse(sim, t1), impulse(ref, t1d), mean)
 
 
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    print("run | probe | first impact t* (data) | peak p* (data) | RMS t* 3-7 | min p* | exact zeros")
+    print("run | probe | first impact t* (data) | peak p* (data) | impulse (data) | RMS t* 3-7 (mean) | min p* | exact zeros")
     for out in sys.argv[1:]:
         path = os.path.join(out, "probes.csv")
         try:
@@ -72,8 +83,9 @@ def main():
                 if not rows or name not in rows[0]:
                     continue
                 sim = [(float(r["t"]) / T_SCALE, float(r[name]) / P_SCALE) for r in rows]
-                t1, t1d, peak, peakd, rms, low, zeros = score(sim, ref)
-                print(f"{out} | {name} | {t1:.3f} ({t1d:.3f}) | {peak:.2f} ({peakd:.2f}) | {rms:.3f} | {low:.2f} | {zeros}")
+                t1, t1d, peak, peakd, rms, low, zeros, imp, impd, mean = score(sim, ref)
+                print(f"{out} | {name} | {t1:.3f} ({t1d:.3f}) | {peak:.2f} ({peakd:.2f}) | {imp:.3f} ({impd:.3f}) | "
+                      f"{rms:.3f} ({mean:+.3f}) | {low:.2f} | {zeros}")
         for gauge in (1, 2, 3, 4):
             name = f"level_H{gauge}"
             if not rows or name not in rows[0]:

@@ -6,7 +6,10 @@
 //! * peak: the largest p* up to 0.5 t* after the first impact (bound 1.5–6, a factor 2 of the recorded event);
 //! * RMS of p*_sim − p*_data (the data interpolated at the sample times) for t* in [3, 7] (bound 0.25);
 //! * the lowest p* (bound −0.5) and the samples of exactly 0 from 0.1 t* after the first impact on (the sensors stay
-//!   under water; ISPH's bound: none).
+//!   under water; ISPH's bound: none);
+//! * the pressure impulse of the first impact, ∫ p* dt* from 0.05 t* before to 0.5 t* after it, each series from its
+//!   own first impact (not bounded: it tells an impact that delivers the recorded momentum in a shorter, taller
+//!   pulse — WCSPH's acoustic one, ρ c0 u — from one that delivers more).
 //!
 //! `bench/lobovsky_score.py` prints the same for any run folder.
 
@@ -29,6 +32,8 @@ const SENSOR_Y: [f64; 2] = [0.003, 0.015];
 const IMPACT: f64 = 0.1;
 /// The post-impact window of the RMS [t*].
 const AFTER: (f64, f64) = (3.0, 7.0);
+/// The window of the first impact's pressure impulse, from its first impact [t*].
+const IMPULSE: (f64, f64) = (-0.05, 0.5);
 
 /// One sensor's scores (dimensionless, t* and p*).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -49,6 +54,13 @@ pub struct SensorScore {
     pub min: f64,
     /// Samples of exactly 0 from 0.1 t* after the first impact on.
     pub zeros: usize,
+    /// Pressure impulse of the first impact, ∫ p* dt* over [`IMPULSE`] from the first impact (records written
+    /// before it was scored read 0).
+    #[serde(default)]
+    pub impulse: f64,
+    /// The recording's, over the same window from its own first impact.
+    #[serde(default)]
+    pub impulse_data: f64,
 }
 
 /// The `--set` overrides that put the sensor probes (the scene's probes 0–3: `p_sensor1`, `p_sensor2` and their
@@ -101,6 +113,8 @@ pub fn score(out: &Path, scenes: &Path) -> anyhow::Result<Vec<SensorScore>> {
                 rms: (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt(),
                 min: sim.iter().map(|p| p.1).fold(f64::INFINITY, f64::min),
                 zeros: sim.iter().filter(|p| p.0 > t1 + 0.1 && p.1 == 0.0).count(),
+                impulse: impulse(&sim, t1),
+                impulse_data: impulse(&data, t1_data),
             })
         })
         .collect()
@@ -108,6 +122,17 @@ pub fn score(out: &Path, scenes: &Path) -> anyhow::Result<Vec<SensorScore>> {
 
 fn first_impact(s: &[(f64, f64)]) -> Option<f64> {
     s.iter().find(|p| p.0 > 1.0 && p.1 >= IMPACT).map(|p| p.0)
+}
+
+/// ∫ p* dt* over [`IMPULSE`] from `t1`, by the trapezoidal rule over the samples in the window (a 1 ms mean is the
+/// interval's integral divided by its length, so on the probes' samples this is that integral to O(Δt²) of the
+/// curve through them).
+fn impulse(s: &[(f64, f64)], t1: f64) -> f64 {
+    let (a, b) = (t1 + IMPULSE.0, t1 + IMPULSE.1);
+    s.windows(2)
+        .filter(|w| w[0].0 >= a && w[1].0 <= b)
+        .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+        .sum()
 }
 
 #[cfg(test)]
@@ -168,6 +193,11 @@ mod tests {
             );
             assert!(s.rms <= 1e-5, "{s:?}");
             assert_eq!((s.min, s.zeros), (0.0, 0), "{s:?}");
+            // ∫ (1.5 + cos(t* − 2.44)) dt* from the impact to 0.5 t* after it: 0.75 + sin 0.5 = 1.2294 (the 0.05
+            // before it are zero), to the sampling of the window's ends (5.7e-3 t* at 1 ms, 4e-3 in the data)
+            let exact = 0.75 + 0.5f64.sin();
+            assert!((s.impulse - exact).abs() <= 0.02, "{s:?}");
+            assert!((s.impulse_data - exact).abs() <= 0.01, "{s:?}");
         }
     }
 }
