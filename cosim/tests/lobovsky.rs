@@ -1,9 +1,9 @@
-//! ISPH on the dam break against a wall of Lobovsky et al. 2014 (`scenes/lobovsky_dam_break.toml`, H = 0.3 m,
-//! Δx = H/30, `cosim run --in-process`, probes every 1 ms): the pressure at sensors 1 (y = 3 mm) and 2 (y = 15 mm),
-//! as the scene's sensor probes report it (the time mean over each sampling interval), against the recorded peak event,
-//! and the water levels at gauges H1–H4 against the recorded levels (issue 16, ISPH acceptance;
-//! `docs/CORRECTIONS.md`, "ISPH pressure"). Times and
-//! pressures in the data's units: t* = t sqrt(g/H), p* = p/(ρgH). About a minute of wall time on one core.
+//! ISPH and WCSPH on the dam break against a wall of Lobovsky et al. 2014 (`scenes/lobovsky_dam_break.toml`,
+//! H = 0.3 m, Δx = H/30, `cosim run --in-process`, probes every 1 ms): the pressure at sensors 1 (y = 3 mm) and 2
+//! (y = 15 mm), as the scene's sensor probes report it (the time mean over each sampling interval), against the
+//! recorded peak event, and the water levels at gauges H1–H4 against the recorded levels (issue 16; ISPH acceptance:
+//! `docs/CORRECTIONS.md`, "ISPH pressure"; WCSPH: "WCSPH at the wall impact"). Times and pressures in the data's
+//! units: t* = t sqrt(g/H), p* = p/(ρgH). About a minute (ISPH) and 15 s (WCSPH) of wall time on one core.
 
 mod common;
 
@@ -89,26 +89,26 @@ impl Sensor {
     }
 }
 
-/// Runs the scene with ISPH and returns sensors 1 and 2, the water-level gauges H1–H4 (level/H) and the run's folder.
-fn isph_h30_run(name: &str) -> ([Sensor; 2], [Sensor; 4], std::path::PathBuf) {
+/// Runs the scene with the `--set`s `sets` and returns sensors 1 and 2, the water-level gauges H1–H4 (level/H) and
+/// the run's folder.
+fn h30_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], std::path::PathBuf) {
     let out = scratch(&format!("lobovsky-{name}"));
     let scene = root().join("scenes/lobovsky_dam_break.toml");
     let (scene_s, out_s, id) = (scene.display().to_string(), out.display().to_string(), run_id(name));
-    let res = cosim_run(
-        &[
-            "run",
-            &scene_s,
-            "--in-process",
-            "--quiet",
-            "--out",
-            &out_s,
-            "--run-id",
-            &id,
-            "--set",
-            "fluid.solver=isph",
-        ],
-        Duration::from_secs(600),
-    );
+    let mut args = vec![
+        "run",
+        &scene_s,
+        "--in-process",
+        "--quiet",
+        "--out",
+        &out_s,
+        "--run-id",
+        &id,
+    ];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    let res = cosim_run(&args, Duration::from_secs(600));
     let summary = json(&out.join("summary.json"));
     assert!(
         res.status.success(),
@@ -168,7 +168,7 @@ fn isph_h30_run(name: &str) -> ([Sensor; 2], [Sensor; 4], std::path::PathBuf) {
 /// jet thrown up the wall falling back through H4's line at t* 4.6–4.9).
 #[test]
 fn isph_h30_impact_time_peak_level_and_no_dropouts() {
-    let (sensors, gauges, out) = isph_h30_run("isph-h30");
+    let (sensors, gauges, out) = h30_run("isph-h30", &["fluid.solver=isph"]);
     // `cosim bench`'s wall-impact case scores a run with its own code (`cosim::bench::lobovsky`): the same numbers.
     let bench = cosim::bench::lobovsky::score(&out, &root().join("scenes")).expect("bench score");
     for g in &gauges {
@@ -229,5 +229,45 @@ fn isph_h30_impact_time_peak_level_and_no_dropouts() {
             b.impulse,
             b.impulse_data
         );
+    }
+}
+
+/// WCSPH with δ-SPH at δ = 0.5 (over the paper's set: Shepard every 20 steps, XSPH, APD): the impact arrives within
+/// ±0.1 t* of the recording, the wall takes the recorded impulse within 25 % (∫ p* dt* from 0.05 t* before the first
+/// impact to 0.5 t* after it), and after the impact (t* in [3, 7]) the RMS difference to the measurement is at most
+/// 0.25 ρgH. Measured: first impact 2.528 / 2.528 (recorded 2.444 / 2.460), impulse 0.940 / 0.896 (0.823 / 0.735:
+/// +14 / +22 %), RMS 0.197 / 0.197 (the paper's set alone: 0.340 / 0.313, an acoustic ringing of the pool that
+/// δ-SPH at 0.5 damps; at H/60 0.145 / 0.151). Not met, and not asserted (issue 16 stays open on them): the peak,
+/// 13.3 / 13.3 ρgH against 3.04 / 1.95 (the water hammer ρ c0 u of the weakly compressible impact, delivered in
+/// 1–3 ms where the recording takes tens), and the lowest sample, −4.7 / −5.3 ρgH (its rebound).
+#[test]
+fn wcsph_h30_with_delta_sph_impact_time_impulse_and_level_after() {
+    let (sensors, _, out) = h30_run("wcsph-h30", &["fluid.density_diffusion=0.5"]);
+    let bench = cosim::bench::lobovsky::score(&out, &root().join("scenes")).expect("bench score");
+    for (s, b) in sensors.iter().zip(&bench) {
+        let (sim, exp) = s.first();
+        eprintln!(
+            "WCSPH H/30, delta-SPH 0.5, {}: first impact t* = {sim:.3} (measured {exp:.3}), impulse {:.3} \
+             (recorded {:.3}), RMS t* 3–7 {:.3} ρgH; not met: peak {:.2} ρgH, lowest {:.2} ρgH",
+            s.name,
+            b.impulse,
+            b.impulse_data,
+            s.rms(),
+            s.peak(),
+            b.min
+        );
+        assert!(
+            (sim - exp).abs() <= 0.1,
+            "{}: first impact at t* = {sim}, measured {exp}",
+            s.name
+        );
+        assert!(
+            (b.impulse / b.impulse_data - 1.0).abs() <= 0.25,
+            "{}: impulse {} against the recording's {}",
+            s.name,
+            b.impulse,
+            b.impulse_data
+        );
+        assert!(s.rms() <= 0.25, "{}: RMS {} ρgH after the impact", s.name, s.rms());
     }
 }

@@ -214,6 +214,19 @@ fn a_still_tank_with_delta_sph_keeps_its_hydrostatic_state() {
     let (mean, std, moved, _) = report("delta-SPH 0.1, no filter", &still_tank(on, false, t_from, t_end));
     let (_, std_plain, moved_plain, _) = report("plain Molteni 0.1, no filter", &still_tank(on, true, t_from, t_end));
     report("paper's set (Shepard every 20)", &still_tank("", false, t_from, t_end));
+    // δ = 0.5 over the paper's set, what damps the Lobovsky impact's ringing (cosim/tests/lobovsky.rs): the tank
+    // keeps its hydrostatic state as well
+    let strong = "density_diffusion = 0.5";
+    let (mean5, std5, moved5, _) = report(
+        "delta-SPH 0.5 + Shepard every 20",
+        &still_tank(strong, false, t_from, t_end),
+    );
+    assert!(
+        (mean5 - p_exact).abs() < 0.02 * p_exact,
+        "δ 0.5: mean {mean5}, exact {p_exact}"
+    );
+    assert!(std5 < 0.02 * rho_g_h, "δ 0.5: std {std5}");
+    assert!(moved5 < 0.5 * DX, "δ 0.5: a particle moved {moved5}");
     report(
         "no filter, no diffusion",
         &still_tank("density_filter = \"none\"", false, t_from, t_end),
