@@ -89,6 +89,16 @@ impl Sensor {
     }
 }
 
+/// The first impact's pressure impulse (the bench's score `b`) within `tol` (relative) of the recording's.
+fn assert_impulse_within(name: &str, b: &cosim::bench::lobovsky::SensorScore, tol: f64) {
+    assert!(
+        (b.impulse / b.impulse_data - 1.0).abs() <= tol,
+        "{name}: impulse {} against the recording's {}",
+        b.impulse,
+        b.impulse_data
+    );
+}
+
 /// Runs the scene with the `--set`s `sets` and returns sensors 1 and 2, the water-level gauges H1–H4 (level/H) and
 /// the run's folder.
 fn h30_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], std::path::PathBuf) {
@@ -217,18 +227,12 @@ fn isph_h30_impact_time_peak_level_and_no_dropouts() {
         // The first impact's pressure impulse, ∫ p* dt* from 0.05 t* before it to 0.5 t* after it (each series from
         // its own impact; the bench's score): the momentum the wall takes, whatever the pulse's shape. Measured
         // 0.809 / 0.673 against the recording's 0.823 / 0.735 (−1.7 / −8.4 %; WCSPH +25 / +16 %, docs/CORRECTIONS.md
-        // "What the WCSPH impact delivers"); bound ±15 %.
+        // "WCSPH at the wall impact"); bound ±15 %.
         eprintln!(
             "ISPH H/30 {}: first-impact impulse {:.3} (recorded {:.3})",
             s.name, b.impulse, b.impulse_data
         );
-        assert!(
-            (b.impulse / b.impulse_data - 1.0).abs() <= 0.15,
-            "{}: impulse {} against the recording's {}",
-            s.name,
-            b.impulse,
-            b.impulse_data
-        );
+        assert_impulse_within(s.name, b, 0.15);
     }
 }
 
@@ -261,13 +265,7 @@ fn wcsph_h30_with_delta_sph_impact_time_impulse_and_level_after() {
             "{}: first impact at t* = {sim}, measured {exp}",
             s.name
         );
-        assert!(
-            (b.impulse / b.impulse_data - 1.0).abs() <= 0.25,
-            "{}: impulse {} against the recording's {}",
-            s.name,
-            b.impulse,
-            b.impulse_data
-        );
+        assert_impulse_within(s.name, b, 0.25);
         assert!(s.rms() <= 0.25, "{}: RMS {} ρgH after the impact", s.name, s.rms());
     }
 }
