@@ -69,36 +69,29 @@ def probes(gauge_csv, c0):
     rows = read_gauge(gauge_csv)
     if not rows:
         sys.exit(f"lobovsky.py: no gauge rows in {gauge_csv}")
+    ts = [r[0] for r in rows]
+    ps = [(pressure(r[1], c0), pressure(r[2], c0)) for r in rows]
+    eps = 1e-12
     out = csv.writer(sys.stdout)
     out.writerow(["t", "p_sensor1", "p_sensor2", "p_sensor1_raw", "p_sensor2_raw"])
-    n = int(round(END / INTERVAL))
-    k = 0  # rows[k] is the first step not yet counted
-    for i in range(1, n + 1):
-        t_end = i * INTERVAL
-        t_start = t_end - INTERVAL
-        acc = [0.0, 0.0]
-        span = 0.0
-        last = None
-        # every step's value holds from its time to the next step's (piecewise constant, weighted by its step)
-        while k < len(rows) and rows[k][0] <= t_end + 1e-12:
-            t0 = max(rows[k][0], t_start)
-            t1 = min(rows[k + 1][0], t_end) if k + 1 < len(rows) else t_end
-            if t1 > t0:
-                p = (pressure(rows[k][1], c0), pressure(rows[k][2], c0))
-                acc = [acc[0] + p[0] * (t1 - t0), acc[1] + p[1] * (t1 - t0)]
-                span += t1 - t0
-            last = rows[k]
-            if k + 1 < len(rows) and rows[k + 1][0] <= t_end + 1e-12:
-                k += 1
-            else:
-                break
-        if last is None or span == 0.0:
-            continue
-        raw = (pressure(last[1], c0), pressure(last[2], c0))
-        out.writerow([f"{t_end:.6f}", acc[0] / span, acc[1] / span, raw[0], raw[1]])
-        # the step in progress at t_end continues into the next interval
-        if k + 1 < len(rows) and rows[k + 1][0] <= t_end + 1e-12:
+    k = 0  # the step in progress at the interval's start
+    for i in range(1, int(round(END / INTERVAL)) + 1):
+        t_start, t_end = (i - 1) * INTERVAL, i * INTERVAL
+        while k + 1 < len(ts) and ts[k + 1] <= t_start + eps:
             k += 1
+        # every step's value holds from its time to the next step's (piecewise constant, weighted by its step)
+        acc, span, j = [0.0, 0.0], 0.0, k
+        while j < len(ts) and ts[j] <= t_end + eps:
+            t0 = max(ts[j], t_start)
+            t1 = min(ts[j + 1], t_end) if j + 1 < len(ts) else t_end
+            if t1 > t0:
+                acc = [acc[0] + ps[j][0] * (t1 - t0), acc[1] + ps[j][1] * (t1 - t0)]
+                span += t1 - t0
+            j += 1
+        if span == 0.0:
+            continue
+        raw = ps[j - 1]  # the last step at or before t_end
+        out.writerow([f"{t_end:.6f}", acc[0] / span, acc[1] / span, raw[0], raw[1]])
 
 
 if __name__ == "__main__":
