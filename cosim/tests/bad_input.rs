@@ -3,7 +3,6 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -14,7 +13,7 @@ const LIMIT: Duration = Duration::from_secs(30);
 const GOOD: &str = BEAM_SCENE;
 
 /// `write_scene` with this file's folder prefix.
-fn write_scene(name: &str, text: &str) -> PathBuf {
+fn write_scene(name: &str, text: &str) -> Scratch {
     common::write_scene("bad", name, text)
 }
 

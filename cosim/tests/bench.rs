@@ -21,8 +21,8 @@ const NUMBERS: [&str; 7] = [
     "threads",
 ];
 
-fn bench(name: &str, args: &[&str]) -> (std::process::Output, std::path::PathBuf) {
-    let out = scratch(name).join("bench");
+fn bench(name: &str, args: &[&str]) -> (std::process::Output, Scratch) {
+    let out = scratch(name).child("bench");
     let mut all = vec!["bench", "--quick", "--out", out.to_str().unwrap()];
     all.extend(args);
     let mut cmd = std::process::Command::new(cosim());
@@ -167,7 +167,7 @@ fn a_blown_up_case_is_a_record_not_an_abort() {
 /// on to the end of its case (the ISPH dam break at the finest quick spacing takes about 18 s here).
 #[test]
 fn a_killed_bench_takes_its_case_with_it() {
-    let out = scratch("bench_killed").join("bench");
+    let out = scratch("bench_killed").child("bench");
     let mut cmd = std::process::Command::new(cosim());
     cmd.current_dir(root())
         .args(["bench", "--quick", "--only", "dam_break", "--solver", "isph", "--out"])

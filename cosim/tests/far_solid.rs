@@ -14,7 +14,7 @@ const LIMIT: Duration = Duration::from_secs(120);
 
 #[test]
 fn a_solid_out_of_reach_gets_no_particles_and_no_contact() {
-    let out = scratch("far_solid").join("out");
+    let out = scratch("far_solid").child("out");
     let mut cmd = std::process::Command::new(cosim());
     cmd.current_dir(root()).env("COSIM_BIN_DIR", bin_dir()).args([
         "run",

@@ -12,8 +12,8 @@ use common::*;
 const LIMIT: Duration = Duration::from_secs(900);
 
 /// Runs `scene` with `sets` (in-process unless `processes`) and returns the output folder.
-fn run(name: &str, scene: &str, sets: &[&str], processes: bool) -> std::path::PathBuf {
-    let out = scratch(name).join("out");
+fn run(name: &str, scene: &str, sets: &[&str], processes: bool) -> Scratch {
+    let out = scratch(name).child("out");
     let run = run_id(name);
     let mut args = vec![
         "run",

@@ -10,7 +10,7 @@ mod common;
 use std::path::Path;
 use std::time::Duration;
 
-use common::{cosim_run, json, root, run_id, scratch};
+use common::{cosim_run, json, root, run_id, scratch, Scratch};
 
 const H: f64 = 0.3;
 const G: f64 = 9.81;
@@ -101,7 +101,7 @@ fn assert_impulse_within(name: &str, b: &cosim::bench::lobovsky::SensorScore, to
 
 /// Runs the scene with the `--set`s `sets` and returns sensors 1 and 2, the water-level gauges H1–H4 (level/H) and
 /// the run's folder.
-fn h30_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], std::path::PathBuf) {
+fn h30_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch) {
     let out = scratch(&format!("lobovsky-{name}"));
     let scene = root().join("scenes/lobovsky_dam_break.toml");
     let (scene_s, out_s, id) = (scene.display().to_string(), out.display().to_string(), run_id(name));

@@ -30,6 +30,8 @@ struct Started {
     out: std::path::PathBuf,
     stderr_path: std::path::PathBuf,
     kids: Vec<(u32, String)>,
+    /// Holds the folder of `out` and `stderr_path` until the test ends.
+    _dir: Scratch,
 }
 
 /// Starts the scene and waits until its three processes run and a few probe samples are written.
@@ -76,6 +78,7 @@ fn start_with(name: &str, in_process: bool) -> Started {
         out,
         stderr_path,
         kids,
+        _dir: dir,
     }
 }
 
@@ -100,6 +103,7 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
         out,
         stderr_path,
         kids,
+        _dir,
     } = start(name);
     let (pid, _) = kids
         .iter()
@@ -145,6 +149,7 @@ fn interrupted() {
             out,
             stderr_path,
             kids,
+            _dir,
         } = start_with(&name, mode == "in-process");
         let kept = samples(&out);
         let hit = Instant::now();
@@ -182,7 +187,13 @@ fn interrupted() {
 /// computing a run nobody collects (before, the broker ran on to the scene's end time).
 #[test]
 fn launcher_killed() {
-    let Started { mut run, out, kids, .. } = start("launcher_killed");
+    let Started {
+        mut run,
+        out,
+        kids,
+        _dir,
+        ..
+    } = start("launcher_killed");
     let kept = samples(&out);
     let hit = Instant::now();
     run.0.kill().unwrap();

@@ -5,7 +5,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -21,7 +21,7 @@ const GATE: [&str; 5] = [
 ];
 
 /// Record the coarse gate into a fresh folder; the folder.
-fn record(name: &str, extra: &[&str]) -> PathBuf {
+fn record(name: &str, extra: &[&str]) -> Scratch {
     let out = scratch(name);
     let out_s = out.display().to_string();
     let id = run_id(name);

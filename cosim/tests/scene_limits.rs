@@ -5,7 +5,6 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::process::Output;
 use std::time::{Duration, Instant};
 
@@ -16,7 +15,7 @@ const LIMIT: Duration = Duration::from_secs(30);
 const PLATE: &str = BEAM_SCENE;
 
 /// `write_scene` with this file's folder prefix.
-fn write_scene(name: &str, text: &str) -> PathBuf {
+fn write_scene(name: &str, text: &str) -> common::Scratch {
     common::write_scene("limits", name, text)
 }
 

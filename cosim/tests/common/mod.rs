@@ -33,12 +33,59 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-/// A fresh empty folder for one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cosim-test-{}-{}", name, std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh empty folder for one test, removed when the test passes and kept (its path is in the failure's message)
+/// when it fails: a suite run would otherwise leave ~1 GB of runs under the temp dir each time.
+pub fn scratch(name: &str) -> Scratch {
+    let path = std::env::temp_dir().join(format!("cosim-test-{}-{}", name, std::process::id()));
+    let _ = std::fs::remove_dir_all(&path);
+    std::fs::create_dir_all(&path).unwrap();
+    Scratch {
+        root: path.clone(),
+        path,
+    }
+}
+
+/// A test's folder (see [`scratch`]); it reads as the `Path` it holds.
+pub struct Scratch {
+    /// What is removed.
+    root: PathBuf,
+    /// What it reads as: `root` or a folder in it.
+    path: PathBuf,
+}
+
+impl Scratch {
+    /// The folder `name` in this one (not created), removed with it.
+    pub fn child(mut self, name: &str) -> Scratch {
+        self.path = self.path.join(name);
+        self
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.path.as_os_str()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.root);
+        }
+    }
 }
 
 /// Run a command, killing it after `limit`; panics on a timeout so no test can hang. The command runs in its own
@@ -252,10 +299,9 @@ point = [0.1, 0.005]
 component = "y"
 "#;
 
-/// Write `text` as `<name>.toml` in a fresh folder `<prefix>-<name>`; its path.
-pub fn write_scene(prefix: &str, name: &str, text: &str) -> PathBuf {
-    let dir = scratch(&format!("{prefix}-{name}"));
-    let path = dir.join(format!("{name}.toml"));
+/// Write `text` as `<name>.toml` in a fresh folder `<prefix>-<name>`; its path, removed with the folder when the test passes.
+pub fn write_scene(prefix: &str, name: &str, text: &str) -> Scratch {
+    let path = scratch(&format!("{prefix}-{name}")).child(&format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
     path
 }
