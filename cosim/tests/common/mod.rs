@@ -33,8 +33,8 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-/// A fresh empty folder for one test, removed when the test passes and kept (its path is in the failure's message)
-/// when it fails: a suite run would otherwise leave ~1 GB of runs under the temp dir each time.
+/// A fresh empty folder for one test (`cosim-test-<name>-<pid>` under the temp dir), removed when the test passes
+/// and kept for a look when it panics: a suite run would otherwise leave ~1 GB of runs under the temp dir each time.
 pub fn scratch(name: &str) -> Scratch {
     let path = std::env::temp_dir().join(format!("cosim-test-{}-{}", name, std::process::id()));
     let _ = std::fs::remove_dir_all(&path);
@@ -299,7 +299,8 @@ point = [0.1, 0.005]
 component = "y"
 "#;
 
-/// Write `text` as `<name>.toml` in a fresh folder `<prefix>-<name>`; its path, removed with the folder when the test passes.
+/// Write `text` as `<name>.toml` in a fresh folder `<prefix>-<name>` ([`scratch`]); its path, removed with the
+/// folder when the test passes.
 pub fn write_scene(prefix: &str, name: &str, text: &str) -> Scratch {
     let path = scratch(&format!("{prefix}-{name}")).child(&format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
