@@ -124,7 +124,7 @@ pub(crate) fn apd_shift_with(
     // Sun et al. 2017, Eq. (7): W(Δx), here at the local spacing Δx_i = sqrt(m_i/ρ_i)
     // 1/W(Δx_i), once a particle: a multiplication a pair where W_ij/W(Δx_i) was a division (issue 20)
     let inv_w_dx = 1.0 / kernel.w((view.m[i] / view.rho[i]).sqrt());
-    let (mut div_r, mut s, mut fluid) = (0.0, [0.0, 0.0], [0.0, 0.0]);
+    let (mut div_r, mut s) = (0.0, [0.0, 0.0]);
     for (k, &j) in neighbors.iter().enumerate() {
         let j = j as usize;
         let (r_ij, r) = separation(xi, view.x[j]);
@@ -136,10 +136,6 @@ pub(crate) fn apd_shift_with(
         div_r -= v_j * dot(r_ij, g);
         if r <= 0.0 {
             continue;
-        }
-        if j < view.n_fluid {
-            fluid[0] += v_j * g[0];
-            fluid[1] += v_j * g[1];
         }
         // Sun et al. 2017, Eq. (7): [1 + R (W_ij/W(Δx))^n] V_j ∇_i W_ij, n = 4 (R: `R_PAIRING`)
         let q = w * inv_w_dx;
@@ -157,6 +153,19 @@ pub(crate) fn apd_shift_with(
     if div_r < NEAR_SURFACE_DIV_R {
         // Sun et al. 2017 / Lind et al. 2012 (free-surface treatment): near the surface only the part tangential
         // to it, normal n = −∇C/|∇C| from the fluid neighbours
+        // Σ_j∈fluid V_j ∇_i W_ij, in a loop of its own for the few particles near the surface: in the loop above
+        // its accumulators and branch made the shift's spill to the stack (issue 20; the same sums in the same
+        // order, so the same bits)
+        let mut fluid = [0.0, 0.0];
+        for (k, &j) in neighbors.iter().enumerate() {
+            let j = j as usize;
+            let (r_ij, r) = separation(xi, view.x[j]);
+            if r > 0.0 && j < view.n_fluid {
+                let (g, v_j) = (grad_of(k, r_ij, r), vol_of(j));
+                fluid[0] += v_j * g[0];
+                fluid[1] += v_j * g[1];
+            }
+        }
         let len = fluid[0].hypot(fluid[1]);
         if len > 0.0 {
             let n = [-fluid[0] / len, -fluid[1] / len];
