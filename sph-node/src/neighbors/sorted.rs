@@ -282,11 +282,12 @@ impl SortedCells {
             chunk.cand_idx.resize(total, 0);
             chunk.cand_d2.resize(total, 0.0);
         }
-        // Branch-free compaction: every candidate is written, the count advances only for a neighbour.
+        // Branch-free compaction: every candidate is written, the count advances only for a neighbour. The
+        // candidate buffers are taken as slices of the block's size, and a row's fluid as a slice of `x`, so that
+        // the loop keeps their addresses in registers and checks no index of `x` (issue 20).
         let mut n = 0;
-        let (cand_idx, cand_d2) = (&mut chunk.cand_idx, &mut chunk.cand_d2);
-        let mut visit = |j: usize| {
-            let p = x[j];
+        let (cand_idx, cand_d2) = (&mut chunk.cand_idx[..total], &mut chunk.cand_d2[..total]);
+        let mut visit = |j: usize, p: [f64; 2]| {
             let dx = xi[0] - p[0];
             let dy = xi[1] - p[1];
             let d2 = dx * dx + dy * dy;
@@ -294,21 +295,26 @@ impl SortedCells {
             cand_d2[n] = d2;
             n += usize::from((d2 < r2max) & (j != i));
         };
+        macro_rules! visit_fluid {
+            ($a:expr, $b:expr) => {{
+                let (a, b) = ($a as usize, $b as usize);
+                for (j, &p) in (a..b).zip(&x[a..b]) {
+                    visit(j, p);
+                }
+            }};
+        }
         for y in y0..=y1 {
             let row = y * d0;
             if self.wall_start[row + x0] == self.wall_start[row + x1 + 1] {
                 // No walls in this row of the block: its fluid is one contiguous range.
-                for j in self.fluid_start[row + x0]..self.fluid_start[row + x1 + 1] {
-                    visit(j as usize);
-                }
+                visit_fluid!(self.fluid_start[row + x0], self.fluid_start[row + x1 + 1]);
                 continue;
             }
             for c in row + x0..=row + x1 {
-                for j in self.fluid_start[c]..self.fluid_start[c + 1] {
-                    visit(j as usize);
-                }
+                visit_fluid!(self.fluid_start[c], self.fluid_start[c + 1]);
                 for &w in &self.wall_sorted[self.wall_start[c] as usize..self.wall_start[c + 1] as usize] {
-                    visit(n_fluid + w as usize);
+                    let j = n_fluid + w as usize;
+                    visit(j, x[j]);
                 }
             }
         }
