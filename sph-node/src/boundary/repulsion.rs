@@ -54,10 +54,17 @@ impl Repulsion {
     #[inline]
     pub fn acceleration(&self, walls: &WallBoxes, x: [f64; 2]) -> [f64; 2] {
         let mut a = [0.0, 0.0];
+        // Beyond this squared distance `hypot` is certainly ≥ d0 (r² is within 4 ulp of |r|², hypot within 1 ulp of
+        // |r|): most particles are far from most boxes, and `hypot` is a slow library call (issue 20; the same
+        // bits, it decides only what `d >= range` below would).
+        let far2 = self.range * self.range * (1.0 + 1e-9);
         for (lo, hi) in walls.boxes() {
             // Nearest point of the box and the distance to it.
             let c = [x[0].clamp(lo[0], hi[0]), x[1].clamp(lo[1], hi[1])];
             let r = [x[0] - c[0], x[1] - c[1]];
+            if r[0] * r[0] + r[1] * r[1] >= far2 {
+                continue;
+            }
             let d = r[0].hypot(r[1]);
             if d >= self.range || d <= 0.0 {
                 // Out of range; or inside the box, which the wall guard deals with.
