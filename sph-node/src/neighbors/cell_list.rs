@@ -8,12 +8,12 @@
 
 use rayon::prelude::*;
 
+use super::grid::Grid;
+
 /// Particles binned on a uniform grid.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CellList {
-    origin: [f64; 2],
-    cell_size: f64,
-    dims: [usize; 2],
+    grid: Grid,
     /// `cell_start[c]..cell_start[c + 1]` indexes `sorted` for cell c.
     cell_start: Vec<u32>,
     /// Particle indices sorted by cell (stable).
@@ -44,14 +44,13 @@ impl CellList {
             lo = [0.0; 2];
             hi = [0.0; 2];
         }
-        self.origin = lo;
-        self.cell_size = cell_size;
-        self.dims = [0, 1].map(|k| ((hi[k] - lo[k]) / cell_size).floor() as usize + 1);
-        let n_cells = self.dims[0] * self.dims[1];
+        self.grid = Grid::covering(lo, hi, cell_size);
+        let grid = self.grid;
+        let n_cells = grid.n_cells();
         // Counting sort by cell index: O(N + cells), stable.
         self.cell_start.clear();
         self.cell_start.resize(n_cells + 1, 0);
-        let cells: Vec<u32> = positions.par_iter().map(|&p| self.cell_of(p) as u32).collect();
+        let cells: Vec<u32> = positions.par_iter().map(|&p| grid.cell_of(p) as u32).collect();
         for &c in &cells {
             self.cell_start[c as usize + 1] += 1;
         }
@@ -66,20 +65,6 @@ impl CellList {
             self.sorted[*slot as usize] = i as u32;
             *slot += 1;
         }
-    }
-
-    fn coords(&self, p: [f64; 2]) -> [usize; 2] {
-        [0, 1].map(|k| {
-            // `as usize` truncates, which is the floor for c ≥ 0, and c < 0 (or NaN) clamps to 0 either way: no
-            // `floor`, a library call on baseline x86-64, for every particle at every sort (issue 20)
-            let c = (p[k] - self.origin[k]) / self.cell_size;
-            (c.max(0.0) as usize).min(self.dims[k] - 1)
-        })
-    }
-
-    fn cell_of(&self, p: [f64; 2]) -> usize {
-        let [cx, cy] = self.coords(p);
-        cy * self.dims[0] + cx
     }
 
     /// Particle indices in cell order (the memory order of the gathers).
@@ -101,15 +86,12 @@ impl CellList {
             return;
         }
         let r2 = radius * radius;
-        let [cx, cy] = self.coords(query);
-        let y0 = cy.saturating_sub(1);
-        let y1 = (cy + 1).min(self.dims[1] - 1);
-        let x0 = cx.saturating_sub(1);
-        let x1 = (cx + 1).min(self.dims[0] - 1);
+        let d0 = self.grid.dims()[0];
+        let ([y0, y1], [x0, x1]) = self.grid.block(self.grid.cell_of(query));
         for y in y0..=y1 {
             // Cells x0..=x1 of one row are contiguous in `sorted`.
-            let a = self.cell_start[y * self.dims[0] + x0] as usize;
-            let b = self.cell_start[y * self.dims[0] + x1 + 1] as usize;
+            let a = self.cell_start[y * d0 + x0] as usize;
+            let b = self.cell_start[y * d0 + x1 + 1] as usize;
             for &j in &self.sorted[a..b] {
                 if Some(j as usize) == exclude {
                     continue;

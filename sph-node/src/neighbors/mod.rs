@@ -1,7 +1,9 @@
 //! Neighbour search.
 
 pub mod cell_list;
+pub mod grid;
 pub mod sorted;
 
 pub use cell_list::{CellList, ListChunk, NeighborList, CHUNK};
-pub use sorted::{Grid, SortedCells};
+pub use grid::Grid;
+pub use sorted::SortedCells;

@@ -2,7 +2,7 @@
 //! memory, so that the particles of one cell, and of the cells of one grid row, are contiguous; wall particles
 //! do not move, so they keep their order and are binned by cell once (again only when the grid changes).
 //!
-//! The grid is the one [`super::CellList`] builds over all particles (fluid and walls): cell size = kernel
+//! The grid ([`Grid`]) is the one [`super::CellList`] builds over all particles (fluid and walls): cell size = kernel
 //! support, origin at the lower corner of the bounding box. A gather visits the 3 × 3 block of cells row by row
 //! (bottom to top), cells left to right, and inside a cell the fluid particles by id, then the wall particles by
 //! index, which is exactly the order of [`super::CellList::gather_into`] on the combined fluid-then-wall array:
@@ -14,59 +14,8 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::cell_list::{ListChunk, NeighborList};
+use super::grid::Grid;
 use crate::kernel::CubicSpline;
-
-/// A uniform grid over a bounding box.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Grid {
-    origin: [f64; 2],
-    cell_size: f64,
-    dims: [usize; 2],
-}
-
-impl Grid {
-    /// Cells of size `cell_size` covering the box `lo`–`hi` (as [`super::CellList`] bins).
-    pub fn covering(lo: [f64; 2], hi: [f64; 2], cell_size: f64) -> Self {
-        Self {
-            origin: lo,
-            cell_size,
-            dims: [0, 1].map(|k| ((hi[k] - lo[k]) / cell_size).floor() as usize + 1),
-        }
-    }
-
-    /// Number of cells.
-    pub fn n_cells(&self) -> usize {
-        self.dims[0] * self.dims[1]
-    }
-
-    /// Cell coordinates of `p` (clamped to the grid).
-    #[inline]
-    pub fn coords(&self, p: [f64; 2]) -> [usize; 2] {
-        [0, 1].map(|k| {
-            // `as usize` truncates, which is the floor for c ≥ 0, and c < 0 (or NaN) clamps to 0 either way: no
-            // `floor`, a library call on baseline x86-64, for every particle at every sort (issue 20)
-            let c = (p[k] - self.origin[k]) / self.cell_size;
-            (c.max(0.0) as usize).min(self.dims[k] - 1)
-        })
-    }
-
-    /// Cell index of `p` (row-major, x fastest).
-    #[inline]
-    pub fn cell_of(&self, p: [f64; 2]) -> usize {
-        let [cx, cy] = self.coords(p);
-        cy * self.dims[0] + cx
-    }
-
-    /// The 3 × 3 block around cell `c`: rows `y0..=y1`, columns `x0..=x1` (clipped at the grid's edges).
-    #[inline]
-    fn block(&self, c: usize) -> ([usize; 2], [usize; 2]) {
-        let (cx, cy) = (c % self.dims[0], c / self.dims[0]);
-        (
-            [cy.saturating_sub(1), (cy + 1).min(self.dims[1] - 1)],
-            [cx.saturating_sub(1), (cx + 1).min(self.dims[0] - 1)],
-        )
-    }
-}
 
 /// Lower and upper corners of the bounding box of `x` (`None` when empty).
 fn bounds(x: &[[f64; 2]]) -> Option<([f64; 2], [f64; 2])> {
@@ -270,7 +219,7 @@ impl SortedCells {
     fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {
         let radius = kernel.support();
         let r2max = radius * radius;
-        let d0 = self.grid.dims[0];
+        let d0 = self.grid.dims()[0];
         let xi = x[i];
         let ([y0, y1], [x0, x1]) = self.grid.block(self.fluid_cell[i] as usize);
         // Candidates of the block, in gather order.
@@ -333,7 +282,7 @@ impl SortedCells {
     /// ranges where the block is clipped), in gather order.
     #[inline]
     pub fn fluid_near_wall(&self, w: usize) -> [Range<usize>; 3] {
-        let d0 = self.grid.dims[0];
+        let d0 = self.grid.dims()[0];
         let ([y0, y1], [x0, x1]) = self.grid.block(self.wall_cell[w] as usize);
         let row = |y: usize| {
             if y > y1 {
