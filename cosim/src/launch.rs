@@ -413,9 +413,7 @@ fn announce_external(
         serde_json::json!({"node": node.name(), "run": run, "connect": connect, "mode": mode, "wait_seconds": wait});
     // Written whole, then renamed into place: a script that waits for the file to appear (as
     // `cosim/tests/run_identity.rs` does) must never read it empty or half written.
-    let tmp = out.join("external.json.tmp");
-    std::fs::write(&tmp, format!("{doc:#}\n")).with_context(|| format!("cannot write {}", tmp.display()))?;
-    std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))?;
+    contact_broker::output::write_atomic(&path, format!("{doc:#}\n").as_bytes())?;
     let flag = if mode == "client" { " --client" } else { "" };
     eprintln!(
         "cosim: waiting up to {wait} s for an external {} node to join run {run} at {connect} (as `{} --run {run} \

@@ -96,7 +96,7 @@ impl OutputError {
 /// Write `bytes` to `path` through a temporary sibling and a rename, so that a reader (or a run that dies
 /// mid-write) sees either the old file or the new one, never a torn one. A write that fails (a full disk) removes
 /// the temporary file and names `path`.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     with_temporary(path, |tmp| std::fs::write(tmp, bytes))
 }
 
