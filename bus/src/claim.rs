@@ -39,24 +39,30 @@ pub struct Taken {
 /// that `session` can reach. Call it before declaring anything on the run's keys.
 pub fn ensure_free(session: &Session, run: &str, alive: &str, who: &str) -> anyhow::Result<()> {
     let key = key(run, alive);
-    let replies = session
-        .liveliness()
-        .get(&key)
-        .timeout(CLAIM_TIMEOUT)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot ask whether run `{run}` is live ({key}): {e}"))?;
+    match held(session, &key, CLAIM_TIMEOUT)
+        .map_err(|e| anyhow::anyhow!("cannot ask whether run `{run}` is live ({key}): {e}"))?
+    {
+        true => Err(Taken {
+            run: run.into(),
+            who: who.into(),
+            key,
+        }
+        .into()),
+        false => Ok(()),
+    }
+}
+
+/// Whether a liveliness token on `key` is held by a process that `session` can reach, asked once (a liveliness
+/// `get`, answered within `timeout`).
+pub fn held(session: &Session, key: &str, timeout: Duration) -> zenoh::Result<bool> {
+    let replies = session.liveliness().get(key).timeout(timeout).wait()?;
     // The channel closes once every answer is in (or at the timeout); any token answering means it is held.
     while let Ok(reply) = replies.recv() {
         if reply.result().is_ok() {
-            return Err(Taken {
-                run: run.into(),
-                who: who.into(),
-                key,
-            }
-            .into());
+            return Ok(true);
         }
     }
-    Ok(())
+    Ok(false)
 }
 
 /// Whether `e` is a refusal by [`ensure_free`] or [`ensure_not_started`] (or by a node that found its run served by

@@ -1,13 +1,14 @@
 //! The zenoh side of the co-simulation's processes, shared by every node binary and the broker: session
 //! settings (`session`), the claim a process makes on its run id (`claim`), the loop a solver node runs to serve a
-//! run (`serve`), the live status every process answers queries with (`status`), the catching of Ctrl-C
-//! (`interrupt`), logging that survives a full disk (`log`) and the machine's available memory a scene is sized
-//! against (`memory`). Solver libraries never see it.
+//! run (`serve`), telling a lost link from a partner gone (`link_loss`), the live status every process answers
+//! queries with (`status`), the catching of Ctrl-C (`interrupt`), logging that survives a full disk (`log`) and the
+//! machine's available memory a scene is sized against (`memory`). Solver libraries never see it.
 #![warn(missing_docs)]
 
 pub mod claim;
 pub mod cli;
 pub mod interrupt;
+pub mod link_loss;
 pub mod log;
 pub mod memory;
 pub mod serve;

@@ -256,7 +256,19 @@ fn serve_session<C: NodeCore>(
         let Some(sample) = commands.recv_timeout(Duration::from_millis(50)).map_err(zerr)? else {
             while let Ok(Some(s)) = broker_alive.try_recv() {
                 if s.kind() == SampleKind::Delete {
-                    anyhow::bail!("the broker of run {run} went away");
+                    // A link lost and restored also takes the token away for a moment (`crate::link_loss`).
+                    let broker = key(run, topic::BROKER_ALIVE);
+                    let (back, after) = crate::link_loss::comes_back(session, &broker, crate::link_loss::GRACE);
+                    if !back {
+                        anyhow::bail!(
+                            "the broker of run {run} went away (its liveliness token was gone for {:.1} s)",
+                            after.as_secs_f64()
+                        );
+                    }
+                    tracing::warn!(
+                        "the broker's liveliness token was away for {:.2} s (a link lost and restored): going on",
+                        after.as_secs_f64()
+                    );
                 }
             }
             continue;

@@ -90,6 +90,11 @@ pub trait NodeLink {
     /// The node's whole state after the last step it answered, in its own format, for a checkpoint
     /// (`docs/PROTOCOL.md` §9). Asked for only between two steps.
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError>;
+
+    /// The run ended before its end time (a failure, an interrupt): tell the node to stop, as far as it can still
+    /// be told, so that it exits now instead of [`cosim_bus::link_loss::GRACE`] later, when it finds the broker
+    /// gone. Best effort: the run's outcome is already decided.
+    fn farewell(&mut self) {}
 }
 
 /// The structure node.

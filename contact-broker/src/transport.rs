@@ -19,6 +19,7 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
+use cosim_bus::link_loss;
 use cosim_proto::trace::Kind;
 
 pub use cosim_bus::session::{
@@ -103,8 +104,8 @@ pub struct ZenohLink<S, T> {
     error: Sub,
     alive: Sub,
     step_timeout: Duration,
-    /// The last command sent (its step and bytes), to send again when its answer does not come.
-    last_command: Option<(u64, ZBytes)>,
+    /// The last command sent (its step, time and bytes), to send again when its answer does not come.
+    last_command: Option<(u64, f64, ZBytes)>,
     /// The registration as received (its step and bytes), for the trace.
     registration: (u64, Vec<u8>),
     /// Where every message sent and accepted is recorded (`--record`).
@@ -229,7 +230,28 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
                         return Err(e);
                     }
                 }
-                return Err(self.failed("the node died (its liveliness token disappeared)"));
+                // A link lost and restored also takes the token away for a moment (`cosim_bus::link_loss`).
+                let alive = key(&self.run, self.topics.alive);
+                let (back, after) = link_loss::comes_back(&self.session, &alive, link_loss::GRACE);
+                if back {
+                    tracing::warn!(
+                        "{}'s liveliness token was away for {:.2} s (a link lost and restored): going on",
+                        self.topics.name,
+                        after.as_secs_f64()
+                    );
+                    // What was sent while the link was down is lost: the last command goes again at once rather
+                    // than at the next resend (a node that answered it answers again, computing nothing).
+                    if let Some((step, _, bytes)) = &self.last_command {
+                        if let Err(e) = self.command.put(bytes.clone()).wait() {
+                            tracing::warn!("{}: cannot send step {step} again: {e}", self.topics.name);
+                        }
+                    }
+                    continue;
+                }
+                return Err(self.failed(format!(
+                    "the node died (its liveliness token disappeared, and was not back within {:.1} s)",
+                    after.as_secs_f64()
+                )));
             }
         }
         Ok(())
@@ -240,7 +262,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     fn node_error(&self, sample: &Sample) -> Option<LinkError> {
         let e = node_error(sample, &self.run, &self.topics)?;
         if let Some(tap) = &self.tap {
-            let step = self.last_command.as_ref().map_or(0, |(s, _)| *s);
+            let step = self.last_command.as_ref().map_or(0, |(s, _, _)| *s);
             tap.record(Kind::Error, step, &sample.payload().to_bytes());
         }
         Some(e)
@@ -273,8 +295,29 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             .put(bytes.clone())
             .wait()
             .map_err(|e| self.failed(format!("cannot send step {step}: {e}")))?;
-        self.last_command = Some((step, bytes));
+        self.last_command = Some((step, t, bytes));
         Ok(())
+    }
+
+    fn farewell(&mut self) {
+        // The node waits for the step after the last command it was sent (or is still computing that one: it
+        // answers, then reads this). Not recorded: a trace holds the run's own messages.
+        let (step, t) = self.last_command.as_ref().map_or((0, 0.0), |(s, t, _)| (s + 1, *t));
+        let stop = StepCommand {
+            dt: 0.0,
+            corrections: Vec::new(),
+            roi: None,
+            want_interface: false,
+            want_snapshot: false,
+            stop: true,
+        };
+        let sent = Envelope::new(&self.run, step, t, stop)
+            .encode_checked(self.topics.command)
+            .map_err(|e| e.to_string())
+            .and_then(|bytes| self.command.put(bytes).wait().map_err(|e| e.to_string()));
+        if let Err(e) = sent {
+            tracing::debug!("cannot tell {} to stop: {e}", self.topics.name);
+        }
     }
 
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
@@ -367,7 +410,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             self.check_node()?;
             if Instant::now() > resend_at && Instant::now() < deadline {
                 resend_at += resend_every;
-                if let Some((_, bytes)) = self.last_command.as_ref().filter(|(s, _)| *s == step) {
+                if let Some((_, _, bytes)) = self.last_command.as_ref().filter(|(s, _, _)| *s == step) {
                     tracing::warn!(
                         "{}: no answer to step {step} after {:.0} s: sending the command again",
                         self.topics.name,

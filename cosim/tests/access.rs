@@ -13,6 +13,7 @@
 
 mod common;
 
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -150,6 +151,80 @@ fn three_processes_started_by_hand_through_a_router_process() {
     assert!(
         probes(&out) == reference_probes(&dir, "by-hand"),
         "the run started by hand differs from its in-process twin"
+    );
+}
+
+/// The router of a run killed mid-run and started again on its endpoint: every process loses its link, and every
+/// partner's liveliness token with it, for about a second (a zenoh client retries its router at once, then after a
+/// second). The run goes on (`cosim_bus::link_loss`): no process calls the others gone, the broker sends its last
+/// commands again, and the probes are those of the in-process twin, byte for byte.
+#[test]
+fn a_run_outlives_its_router_restarting() {
+    let dir = scratch("router-restart");
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let (router, _) = start_router(&endpoint, None, &dir.join("router.stderr"));
+    // Twice the others' end time, so that the restart falls well inside the run (the later `--set` wins).
+    let settings = ["--set", "fluid.spacing=0.004", "--set", "run.end_time=0.1"];
+    let out = dir.join("restarted");
+    let mut run = Kill(
+        Command::new(cosim())
+            .current_dir(root())
+            .env("COSIM_BIN_DIR", bin_dir())
+            .arg("run")
+            .arg(scene())
+            .args(["--quiet", "--run-id", &run_id("router-restart"), "--out"])
+            .arg(&out)
+            .args(settings)
+            .args(["--connect", &endpoint])
+            .process_group(0)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(dir.join("cosim.stderr")).unwrap())
+            .spawn()
+            .unwrap(),
+    );
+    // The router goes once the run has written its first probe samples after t = 0 (one every 5 ms of 100).
+    let until = Instant::now() + LIMIT;
+    while std::fs::read_to_string(out.join("probes.csv")).map_or(0, |t| t.lines().count()) < 3 {
+        assert!(
+            run.0.try_wait().unwrap().is_none(),
+            "the run ended before its router was stopped"
+        );
+        assert!(Instant::now() < until, "the run wrote no samples");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    drop(router);
+    assert!(
+        run.0.try_wait().unwrap().is_none(),
+        "the run ended before its router was stopped"
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let (_router, _) = start_router(&endpoint, None, &dir.join("router2.stderr"));
+
+    let status = wait_exit(&mut run.0, Instant::now() + LIMIT, "cosim run");
+    let said = std::fs::read_to_string(dir.join("cosim.stderr")).unwrap_or_default();
+    assert!(status.success(), "after the router restarted: {said}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "ok", "{summary}");
+    // Each process saw its partners' tokens go and come back.
+    for name in ["contact-broker", "fem-node", "sph-node"] {
+        let log = std::fs::read_to_string(out.join(format!("logs/{name}.log"))).unwrap_or_default();
+        assert!(
+            log.contains("a link lost and restored"),
+            "{name} did not see the link go: {log}"
+        );
+    }
+    let alone = dir.join("alone");
+    let output = cosim_run_scene(
+        &alone,
+        &run_id("router-restart-alone"),
+        &["--in-process", settings[2], settings[3]],
+        LIMIT,
+    );
+    assert!(output.status.success(), "in-process reference: {}", stderr(&output));
+    assert!(
+        probes(&out) == probes(&alone),
+        "the run whose router restarted differs from its in-process twin"
     );
 }
 

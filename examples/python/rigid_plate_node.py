@@ -279,18 +279,26 @@ def main():
     expected, steps, started = 0, 0, time.monotonic()
     last = None  # (command bytes, answer bytes): a command that comes again is answered again (PROTOCOL.md §8)
     # When the broker's token goes, its last command (the stop at the end of a run) may still be on its way: the
-    # two subscriptions deliver in no common order. As the Rust nodes do (they look at the token only when no
-    # command has come for 50 ms), keep taking commands for a moment and fail only if none comes.
-    gone = False
+    # two subscriptions deliver in no common order. And a link lost and restored (a router restarted) takes the
+    # token away for a moment too. As the Rust nodes do (PROTOCOL.md §8), keep taking commands, ask for the token
+    # every 0.2 s, and fail only when it has been gone for GRACE seconds.
+    grace, gone_since = 4.0, None
     while True:
         try:
-            kind, payload = inbox.get(timeout=0.5 if gone else args.timeout)
+            kind, payload = inbox.get(timeout=0.2 if gone_since is not None else args.timeout)
         except queue.Empty:
-            if gone:
-                fail("the broker is gone (broker/alive disappeared)")
-            fail(f"no command for {args.timeout} s (step {expected})")
+            if gone_since is None:
+                fail(f"no command for {args.timeout} s (step {expected})")
+            if any(r.ok is not None for r in session.liveliness().get(f"{base}/broker/alive", timeout=0.2)):
+                gone_since = None  # back: going on
+            elif time.monotonic() - gone_since > grace:
+                fail(f"the broker is gone (broker/alive disappeared for {grace:.0f} s)")
+            continue
         if kind == "broker":
-            gone = gone or payload == zenoh.SampleKind.DELETE
+            if payload == zenoh.SampleKind.DELETE:
+                gone_since = gone_since if gone_since is not None else time.monotonic()
+            else:
+                gone_since = None
             continue
         if last is not None and payload == last[0]:
             pub_state.put(last[1])  # the broker sent it again: our answer was lost; compute nothing

@@ -147,6 +147,16 @@ pub(super) fn stop(nodes: &mut Nodes<'_>, step: u64, t: f64) -> anyhow::Result<(
     Ok(())
 }
 
+/// A run that ended early: every node still there is told to stop (`NodeLink::farewell`).
+pub(super) fn farewell(nodes: &mut Nodes<'_>) {
+    if let Some(link) = nodes.fem.as_deref_mut() {
+        link.farewell();
+    }
+    if let Some(link) = nodes.sph.as_deref_mut() {
+        link.farewell();
+    }
+}
+
 /// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state,
 /// ends `unstable`: the node blew up without noticing), naming the message, the field, the index and the value.
 fn unusable(node: &str, e: Invalid) -> LinkError {

@@ -96,8 +96,10 @@ pub fn run_debug(
     )
     .err();
     if error.is_some() {
-        // What the nodes still alive counted up to the failure (a finished run asked them before its stop).
+        // What the nodes still alive counted up to the failure (a finished run asked them before its stop); then
+        // they are told to stop.
         collect_counts(&mut nodes, &mut summary);
+        exchange::farewell(&mut nodes);
     }
     // Whatever happened, the probes computed so far are plotted and the summary is written.
     let t_plot = Instant::now();
