@@ -303,14 +303,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         // The node waits for the step after the last command it was sent (or is still computing that one: it
         // answers, then reads this). Not recorded: a trace holds the run's own messages.
         let (step, t) = self.last_command.as_ref().map_or((0, 0.0), |(s, t, _)| (s + 1, *t));
-        let stop = StepCommand {
-            dt: 0.0,
-            corrections: Vec::new(),
-            roi: None,
-            want_interface: false,
-            want_snapshot: false,
-            stop: true,
-        };
+        let stop = StepCommand::bare_stop();
         let sent = Envelope::new(&self.run, step, t, stop)
             .encode_checked(self.topics.command)
             .map_err(|e| e.to_string())

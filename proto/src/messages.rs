@@ -78,6 +78,21 @@ pub struct StepCommand {
     pub stop: bool,
 }
 
+impl StepCommand {
+    /// A stop with nothing to apply: what a node is told when a run ends without the stop of its last step (a
+    /// run that failed, a replayed trace cut short).
+    pub fn bare_stop() -> Self {
+        Self {
+            dt: 0.0,
+            corrections: Vec::new(),
+            roi: None,
+            want_interface: false,
+            want_snapshot: false,
+            stop: true,
+        }
+    }
+}
+
 /// Energies of one solid [J per unit thickness].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Energies {

@@ -208,14 +208,7 @@ impl Player {
         // The trace ends without the stop (a run cut short): the node is told to stop as a finished run would.
         if let Some(x) = last {
             let t = RawEnvelope::split(&x.command).map_or(0.0, |e| e.t);
-            let stop = StepCommand {
-                dt: 0.0,
-                corrections: Vec::new(),
-                roi: None,
-                want_interface: false,
-                want_snapshot: false,
-                stop: true,
-            };
+            let stop = StepCommand::bare_stop();
             let _ = self.send(Envelope::new(&self.run, x.step + 1, t, stop).encode(), x.step + 1);
             let _ = self.wait_exit();
         }
