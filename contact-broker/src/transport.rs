@@ -215,6 +215,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         }
     }
 
+    /// Send the command of `step` again, byte for byte (a node that answered it answers again).
+    fn send_again(&self, step: u64, bytes: &ZBytes) {
+        if let Err(e) = self.command.put(bytes.clone()).wait() {
+            tracing::warn!("{}: cannot send step {step} again: {e}", self.topics.name);
+        }
+    }
+
     /// A failure the node reported or its death, if either happened.
     fn check_node(&self) -> Result<(), LinkError> {
         while let Ok(Some(sample)) = self.error.try_recv() {
@@ -242,9 +249,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
                     // What was sent while the link was down is lost: the last command goes again at once rather
                     // than at the next resend (a node that answered it answers again, computing nothing).
                     if let Some((step, _, bytes)) = &self.last_command {
-                        if let Err(e) = self.command.put(bytes.clone()).wait() {
-                            tracing::warn!("{}: cannot send step {step} again: {e}", self.topics.name);
-                        }
+                        self.send_again(*step, bytes);
                     }
                     continue;
                 }
@@ -409,9 +414,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                         self.topics.name,
                         started.elapsed().as_secs_f64()
                     );
-                    if let Err(e) = self.command.put(bytes.clone()).wait() {
-                        tracing::warn!("{}: cannot send step {step} again: {e}", self.topics.name);
-                    }
+                    self.send_again(step, bytes);
                 }
             }
             if Instant::now() > deadline {

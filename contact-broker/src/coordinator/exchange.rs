@@ -30,15 +30,15 @@ pub(super) fn check_registrations(nodes: &Nodes<'_>) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A command with nothing to correct and no region of interest.
-pub(super) fn command(dt: f64, want_snapshot: bool, stop: bool) -> StepCommand {
+/// A step command with nothing to correct and no region of interest.
+fn command(dt: f64, want_snapshot: bool) -> StepCommand {
     StepCommand {
         dt,
         corrections: Vec::new(),
         roi: None,
         want_interface: false,
         want_snapshot,
-        stop,
+        stop: false,
     }
 }
 
@@ -54,13 +54,13 @@ pub(super) fn commands(
     let fem = StepCommand {
         corrections: std::mem::take(&mut pending.fem),
         want_interface: coupled,
-        ..command(dt, want_snapshot, false)
+        ..command(dt, want_snapshot)
     };
     let sph = StepCommand {
         corrections: std::mem::take(&mut pending.sph),
         roi,
         want_interface: coupled,
-        ..command(dt, want_snapshot, false)
+        ..command(dt, want_snapshot)
     };
     (fem, sph)
 }
@@ -137,7 +137,7 @@ pub(super) fn exchange(
 
 /// The last message of a run that reached its end: every node is told to stop.
 pub(super) fn stop(nodes: &mut Nodes<'_>, step: u64, t: f64) -> anyhow::Result<()> {
-    let stop = command(0.0, false, true);
+    let stop = StepCommand::bare_stop();
     if let Some(link) = nodes.fem.as_deref_mut() {
         link.send(step, t, stop.clone())?;
     }
