@@ -59,12 +59,16 @@ pub(super) fn position(
             known = true;
         }
         let mut penetrated = false;
-        // A master that finds no contact has an infinite gap: neither near nor penetrated.
+        // A master that finds no contact has an infinite gap: neither near nor penetrated. A gap within round-off
+        // (−`tol_round` ≤ g) is not a penetration: it is what `position_step` admits, so a position it admitted
+        // is final. Counted against 0, the position it admitted was often "penetrated" again by round-off and
+        // projected again, by ~1e-17 m: 9 exact steps per penetrating particle on the shipped gate, up to
+        // `RIGID_STEPS`, and again in the next sweep (docs/PERFORMANCE.md, 2026-11-28 eighth).
         for (&m, &g) in rigid.iter().zip(&gaps.x0) {
             if first && step == 0 && g <= setup.touch {
                 out.near = true;
             }
-            if g < 0.0 {
+            if g < -setup.tol_round {
                 penetrated = true;
                 out.worst = out.worst.max(-g);
                 if first && step == 0 {
@@ -72,7 +76,6 @@ pub(super) fn position(
                 }
             }
         }
-        // position_step would find the same (no penetration at x0) and return None.
         if !penetrated {
             break;
         }
