@@ -529,8 +529,8 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
     assert_isph_at(2.0);
 }
 
-/// The scene's gate (E = 12 MPa) with ISPH at Δx = 4 mm to t = 0.2 s (about 35 s), at the scene's
-/// `coupling.max_dt = 1e-4` s and at 1e-2 s (the coupling never caps the ISPH step): the fluid's energy must stay
+/// The scene's gate (E = 12 MPa) with ISPH at Δx = 4 mm to t = 0.2 s, at `coupling.max_dt = 1e-2` s (the coupling
+/// never caps the ISPH step; the scene's 1e-4 s is the next test, which passes): the fluid's energy must stay
 /// within the growth bound, as it does with WCSPH (measured: WCSPH +0.0009 of the budget, then falls steadily).
 /// Measured after the PPE's void rows (`sph-node/src/isph/ppe.rs`): +0.242 of the budget at max_dt 1e-4 (was
 /// +0.24–0.26), +0.145 at 1e-2 (was +0.258). Split per part of the step (2026-11-22, closed to 1e-13 J/m per step;
@@ -553,34 +553,49 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
 /// kPa. Choosing the candidate face the particle is furthest in front of (the separating plane of a convex corner)
 /// instead: +0.068 (from +0.071 in that run, output every 2 ms), the kicks at other times remain.
 #[test]
-#[ignore = "found by this test: the coupled ISPH gate gains 6.4 % (max_dt 1e-4, 2026-11-28, free-surface rows blended; \
-            this bounds the fluid alone: fluid + structure gain 18.6 % of the budget, the first layer's face velocity, \
-            docs/CORRECTIONS.md \"The coupled ISPH gate creates energy\", 2026-11-28 eighth; \
+#[ignore = "found by this test: at max_dt 1e-2 the coupled ISPH gate's fluid gains 53 % of its budget (2026-11-28 \
+            eighth; at 1e-4 +0.03 %, from 6.4 %, since inherited contact faces must stand for the structure near the \
+            particle, docs/CORRECTIONS.md \"The coupled ISPH gate creates energy\"); before: 6.4 % at 1e-4 \
+            (2026-11-28, free-surface rows blended; \
             7.4 % on 2026-11-27 night; 6.2 % before the \
             last-bit arithmetic of the speed work, 24 % before the ISPH walls acted on contact only, 10 % before their \
             divergence velocities did too, docs/CORRECTIONS.md \"ISPH pressure\") and 15.2 % (1e-2, at t = 0.145 s, \
             2026-11-28 fourth; with probes every 1 ms instead of 5, which end coupling steps elsewhere, 28.6 %: the \
             gain follows the trajectory's last bits) of the fluid's energy budget by t = 0.2 s and ends ok"]
 fn isph_elastic_gate_stays_within_the_energy_bound() {
+    assert_isph_gate("1e-2");
+}
+
+/// The scene's own coupling step, `coupling.max_dt = 1e-4` s, of the gate above (about 9 s): within the growth
+/// bound since an inherited contact face must stand for the structure near the particle
+/// (`isph::contact::ContactLayer::inherited_face`; measured 2026-11-28 eighth: +0.0003 of the budget, was +0.064;
+/// taking the first neighbour's face again, this test fails). Fluid + structure together gain +0.054 of the
+/// budget (was +0.186; WCSPH +0.0014): docs/CORRECTIONS.md "The coupled ISPH gate creates energy".
+#[test]
+fn isph_elastic_gate_at_the_scenes_coupling_step_stays_within_the_energy_bound() {
+    assert_isph_gate("1e-4");
+}
+
+/// The gate scene (E = 12 MPa) with ISPH at Δx = 4 mm to t = 0.2 s at `coupling.max_dt`: ends ok with the fluid's
+/// energy within the growth and floor bounds.
+fn assert_isph_gate(max_dt: &str) {
     let budget = budget(&GATE_BLOCKS);
     let releasable = releasable(&GATE_BLOCKS, GATE_FLOOR);
-    for max_dt in ["1e-4", "1e-2"] {
-        let case = format!("elastic gate isph, coupling.max_dt = {max_dt}");
-        let sets = gate(GATE_E, &["fluid.solver=isph", &format!("coupling.max_dt={max_dt}")]);
-        let out = run(
-            &format!("gate-isph-{}", max_dt.replace('-', "m")),
-            "scenes/elastic_gate.toml",
-            &sets,
-        );
-        out.assert_ok_and_finite(&case);
-        let e = out.probe("energy");
-        eprintln!(
-            "{case}: energy max {:+.4} / end {:+.4} of the budget, {:.1} s wall",
-            e.iter().copied().fold(f64::NEG_INFINITY, f64::max) / budget,
-            e[e.len() - 1] / budget,
-            out.wall
-        );
-        let energy = assert_energy(&case, &out, budget, releasable);
-        report(&case, &out, energy);
-    }
+    let case = format!("elastic gate isph, coupling.max_dt = {max_dt}");
+    let sets = gate(GATE_E, &["fluid.solver=isph", &format!("coupling.max_dt={max_dt}")]);
+    let out = run(
+        &format!("gate-isph-{}", max_dt.replace('-', "m")),
+        "scenes/elastic_gate.toml",
+        &sets,
+    );
+    out.assert_ok_and_finite(&case);
+    let e = out.probe("energy");
+    eprintln!(
+        "{case}: energy max {:+.4} / end {:+.4} of the budget, {:.1} s wall",
+        e.iter().copied().fold(f64::NEG_INFINITY, f64::max) / budget,
+        e[e.len() - 1] / budget,
+        out.wall
+    );
+    let energy = assert_energy(&case, &out, budget, releasable);
+    report(&case, &out, energy);
 }

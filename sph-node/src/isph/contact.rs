@@ -260,6 +260,40 @@ impl ContactLayer {
         self.flags.get(i).copied().unwrap_or(false).then(|| self.face[i])
     }
 
+    /// The face particle `i` at `x`, against none of its own, takes from its fluid `neighbors` (indices below `nf`):
+    /// of those that are against a face that `cut` accepts, the one whose contact point (where it was put r_c in
+    /// front of the face) is nearest to `x`, and only if the foot of `x` on that face lies within Δx of the point.
+    /// A face stands for the structure near where it was measured: the plate's first layer takes the plane its
+    /// neighbours are held against, but a particle of the jet passing the gate's tip does not take the plane of a
+    /// neighbour corrected at the tip's corner, whose normal there is the corner's (taking the first neighbour's
+    /// face, as before, the coupled ISPH gate gained 18.6 % of its energy budget, docs/CORRECTIONS.md "The coupled
+    /// ISPH gate creates energy").
+    fn inherited_face(
+        &self,
+        i: usize,
+        x: [f64; 2],
+        neighbors: &[u32],
+        nf: usize,
+        dx: f64,
+        cut: impl Fn(&Face) -> bool,
+    ) -> Option<Face> {
+        let mut nearest: Option<(f64, Face)> = None;
+        for j in neighbors.iter().map(|&j| j as usize).filter(|&j| j < nf && j != i) {
+            let Some(face) = self.face(j).filter(&cut) else {
+                continue;
+            };
+            let q = self.point[j];
+            let d2 = (x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2);
+            if nearest.is_none_or(|(best, _)| d2 < best) {
+                nearest = Some((d2, face));
+            }
+        }
+        let (d2, face) = nearest?;
+        let normal = face.distance(x);
+        // The squared distance along the face from the foot of x to the point.
+        (d2 - normal * normal <= dx * dx).then_some(face)
+    }
+
     /// Whether any particle is against a face.
     pub fn any(&self) -> bool {
         self.flags.iter().any(|&f| f)
@@ -273,8 +307,9 @@ impl ContactLayer {
 
 /// The contact rows of the step at the predicted positions `view.x`, and the Dirichlet weights of their particles.
 /// A particle's support is cut by a face when [`ContactLayer::face`] says it is against that face and it is still
-/// within Δx of it, or when it lies within 2h in front of the face of a neighbour that is (the first in the
-/// neighbour list; this includes the particles next to the structure that the contact did not correct lately, and
+/// within Δx of it, or when it lies within 2h in front of the face of a neighbour that is (the neighbour whose
+/// contact point is nearest, if the particle's foot on its face is within Δx of that point,
+/// [`ContactLayer::inherited_face`]; this includes the particles next to the structure that the contact did not correct lately, and
 /// the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
 /// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its Dirichlet weight
 /// (free surface or not) follows ∇·r in front of the face plus the half-space
@@ -304,12 +339,10 @@ pub fn contact_rows_into(
             let x = view.x[i];
             let own = |f: &Face| f.distance(x) <= dx;
             let cut = |f: &Face| (-0.25 * dx..kernel.support()).contains(&f.distance(x));
-            let face = layer.face(i).filter(own).or_else(|| {
-                list.of(i)
-                    .iter()
-                    .filter(|&&j| (j as usize) < nf)
-                    .find_map(|&j| layer.face(j as usize).filter(cut))
-            })?;
+            let face = layer
+                .face(i)
+                .filter(own)
+                .or_else(|| layer.inherited_face(i, x, list.of(i), nf, dx, cut))?;
             let d = face.distance(x).max(-0.25 * dx);
             let (mut div_r, mut w_sum) = half_space(kernel, dx, d);
             w_sum *= rho0;
