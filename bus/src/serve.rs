@@ -400,16 +400,29 @@ fn fetch_restore(
 /// The scene from the run's broker. Every answer is collected (consolidation off: zenoh would otherwise keep one
 /// answer per key), and a run answered by more than one broker is refused ([`crate::claim::Ambiguous`]): two runs
 /// on one run id that started within the moment the brokers' own check cannot see.
+///
+/// Asked again every [`SCENE_RETRY`] until `timeout` while nobody answers: a query that finds no queryable ends at
+/// once with no answer, and a node started as soon as its broker's session was open can ask through a router that
+/// has not yet heard of the broker's queryable (seen over TLS: both nodes gave up within a second, CI of
+/// 2026-11-28, eighth).
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
     let scene_key = key(run, topic::SCENE);
-    let replies = session
-        .get(&scene_key)
-        .consolidation(zenoh::query::ConsolidationMode::None)
-        .timeout(timeout)
-        .wait()
-        .map_err(zerr)?;
-    // The channel closes once every queryable answered (or at the timeout).
-    let answers: Vec<_> = std::iter::from_fn(|| replies.recv().ok()).collect();
+    let deadline = std::time::Instant::now() + timeout;
+    let answers = loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let replies = session
+            .get(&scene_key)
+            .consolidation(zenoh::query::ConsolidationMode::None)
+            .timeout(left.max(SCENE_RETRY))
+            .wait()
+            .map_err(zerr)?;
+        // The channel closes once every queryable answered (or at the timeout).
+        let answers: Vec<_> = std::iter::from_fn(|| replies.recv().ok()).collect();
+        if !answers.is_empty() || std::time::Instant::now() + SCENE_RETRY >= deadline {
+            break answers;
+        }
+        std::thread::sleep(SCENE_RETRY);
+    };
     if answers.len() > 1 {
         return Err(crate::claim::Ambiguous {
             run: run.into(),
@@ -429,3 +442,6 @@ fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Resul
         ),
     }
 }
+
+/// How often a node asks again for the scene while no broker answers ([`fetch_scene`]).
+const SCENE_RETRY: Duration = Duration::from_millis(200);

@@ -265,10 +265,15 @@ def main():
         time.sleep(0.1)
         sys.exit(f"rigid_plate_node: {message}")
 
-    scene_text = None
-    for reply in session.get(f"{base}/scene", timeout=5.0):
-        if reply.ok is not None:
-            scene_text = reply.ok.payload.to_bytes().decode("utf-8")
+    # Asked again while nobody answers: a query that finds no queryable ends at once, and a router may not have
+    # heard of the broker's queryable yet when this node starts (bus/src/serve.rs, fetch_scene).
+    scene_text, deadline = None, time.monotonic() + 5.0
+    while scene_text is None and time.monotonic() < deadline:
+        for reply in session.get(f"{base}/scene", timeout=max(0.2, deadline - time.monotonic())):
+            if reply.ok is not None:
+                scene_text = reply.ok.payload.to_bytes().decode("utf-8")
+        if scene_text is None:
+            time.sleep(0.2)
     if scene_text is None:
         sys.exit(f"rigid_plate_node: nobody served the scene of run {args.run} at {args.connect}")
     plate = RigidPlate(tomllib.loads(scene_text), args.stiffness, args.damping_ratio)
