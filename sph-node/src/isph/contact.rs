@@ -260,7 +260,7 @@ impl ContactLayer {
         self.flags.get(i).copied().unwrap_or(false).then(|| self.face[i])
     }
 
-    /// The face particle `i` at `x`, against none of its own, takes from its fluid `neighbors` (indices below `nf`):
+    /// The face a particle at `x`, against none of its own, takes from its fluid `neighbors` (indices below `nf`):
     /// of those that are against a face that `cut` accepts, the one whose contact point (where it was put r_c in
     /// front of the face) is nearest to `x`, and only if the foot of `x` on that face lies within Δx of the point.
     /// A face stands for the structure near where it was measured: the plate's first layer takes the plane its
@@ -270,7 +270,6 @@ impl ContactLayer {
     /// ISPH gate creates energy").
     fn inherited_face(
         &self,
-        i: usize,
         x: [f64; 2],
         neighbors: &[u32],
         nf: usize,
@@ -278,7 +277,7 @@ impl ContactLayer {
         cut: impl Fn(&Face) -> bool,
     ) -> Option<Face> {
         let mut nearest: Option<(f64, Face)> = None;
-        for j in neighbors.iter().map(|&j| j as usize).filter(|&j| j < nf && j != i) {
+        for j in neighbors.iter().map(|&j| j as usize).filter(|&j| j < nf) {
             let Some(face) = self.face(j).filter(&cut) else {
                 continue;
             };
@@ -309,8 +308,8 @@ impl ContactLayer {
 /// A particle's support is cut by a face when [`ContactLayer::face`] says it is against that face and it is still
 /// within Δx of it, or when it lies within 2h in front of the face of a neighbour that is (the neighbour whose
 /// contact point is nearest, if the particle's foot on its face is within Δx of that point,
-/// [`ContactLayer::inherited_face`]; this includes the particles next to the structure that the contact did not correct lately, and
-/// the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
+/// [`ContactLayer::inherited_face`]; this includes the particles next to the structure that the contact did not
+/// correct lately, and the second row, whose support the face still cuts: without it the hydrostatic field misses the second row's
 /// truncated stencil, 12 % of the gravity flux, and the summation reads a 1 % expansion there). Its Dirichlet weight
 /// (free surface or not) follows ∇·r in front of the face plus the half-space
 /// ([`super::free_surface::dirichlet_weight`]). Distances below −Δx/4 (a particle the
@@ -342,7 +341,7 @@ pub fn contact_rows_into(
             let face = layer
                 .face(i)
                 .filter(own)
-                .or_else(|| layer.inherited_face(i, x, list.of(i), nf, dx, cut))?;
+                .or_else(|| layer.inherited_face(x, list.of(i), nf, dx, cut))?;
             let d = face.distance(x).max(-0.25 * dx);
             let (mut div_r, mut w_sum) = half_space(kernel, dx, d);
             w_sum *= rho0;
