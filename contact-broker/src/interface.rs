@@ -3,7 +3,7 @@
 //! corrections both nodes apply before the next step. Pure: wire messages in, wire messages out.
 
 use cosim_proto::control::ContactRecord;
-use cosim_proto::messages::{Correction, FemMesh, FemState, SphSetup, SphState};
+use cosim_proto::messages::{ContactFace, Correction, FemMesh, FemState, SphSetup, SphState};
 use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
 use crate::contact::{self, ContactAlgorithm};
@@ -51,6 +51,8 @@ pub struct Interface {
     /// the algorithm records none.
     records: Vec<ContactRecord>,
     recorded: bool,
+    /// Send the structure's face with each fluid correction (`particle_particle`, whose corrections do not show it).
+    faces: bool,
 }
 
 impl Interface {
@@ -115,6 +117,7 @@ impl Interface {
             dt: 0.0,
             records: Vec::new(),
             recorded: false,
+            faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
         })
     }
 
@@ -245,9 +248,20 @@ impl Interface {
         let (lin, ang) = momentum_change((&sph.m, &sph.v, &px, &pv), &nx, &node_impulse);
         stats.linear_momentum_change = lin;
         stats.angular_momentum_change = ang;
+        // The face behind a corrected particle, at the corrected positions, where the correction does not show it.
+        let face = |k: usize| {
+            let (point, normal) = contact::nearest_face(&self.segments, &nx, *px.get(k)?)?;
+            Some(ContactFace { point, normal })
+        };
         let corrections = Corrections {
-            fem: diff(&self.node_ids, (&fem.x, &fem.v), (&nx, &nv)),
-            sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv)),
+            fem: diff(&self.node_ids, (&fem.x, &fem.v), (&nx, &nv), |_| None),
+            sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv), |k| {
+                if self.faces {
+                    face(k)
+                } else {
+                    None
+                }
+            }),
         };
         Ok((corrections, stats))
     }
@@ -290,14 +304,24 @@ fn particle_params(scene: &Scene, dx: f64, thickness: f64) -> contact::ParticleP
     }
 }
 
-/// Sparse (id, Δx, Δv) for every entry that changed.
-fn diff(ids: &[u32], before: (&[[f64; 2]], &[[f64; 2]]), after: (&[[f64; 2]], &[[f64; 2]])) -> Vec<Correction> {
+/// Sparse (id, Δx, Δv) for every entry that changed, with `face(k)` of the k-th entry.
+fn diff(
+    ids: &[u32],
+    before: (&[[f64; 2]], &[[f64; 2]]),
+    after: (&[[f64; 2]], &[[f64; 2]]),
+    face: impl Fn(usize) -> Option<ContactFace>,
+) -> Vec<Correction> {
     let mut out = Vec::new();
     for (k, &id) in ids.iter().enumerate() {
         let dx = [after.0[k][0] - before.0[k][0], after.0[k][1] - before.0[k][1]];
         let dv = [after.1[k][0] - before.1[k][0], after.1[k][1] - before.1[k][1]];
         if dx != [0.0; 2] || dv != [0.0; 2] {
-            out.push(Correction { id, dx, dv });
+            out.push(Correction {
+                id,
+                dx,
+                dv,
+                face: face(k),
+            });
         }
     }
     out

@@ -439,6 +439,7 @@ fn bad_commands(count: u32, max_dt: f64) -> Vec<(StepCommand, &'static str)> {
         id,
         dx: [1e-6, 0.0],
         dv: [0.0, 1e-3],
+        face: None,
     };
     let base = StepCommand {
         dt: max_dt,
@@ -533,6 +534,7 @@ fn both_nodes_refuse_an_unusable_command_and_apply_none_of_it() {
             id: nodes - 1,
             dx: [0.0; 2],
             dv: [0.0; 2],
+            face: None,
         }],
         dt: max_dt,
         ..first.clone()
@@ -543,6 +545,7 @@ fn both_nodes_refuse_an_unusable_command_and_apply_none_of_it() {
             id: particles - 1,
             dx: [0.0; 2],
             dv: [0.0; 2],
+            face: None,
         }],
         ..legal
     };

@@ -131,9 +131,9 @@ fn dam_break_error_falls_with_spacing_and_outputs_are_written() {
 #[test]
 fn a_blown_up_case_is_a_record_not_an_abort() {
     // ISPH with the particle-particle contact is unstable on the gate (docs/VALIDATION.md): the gate's elements
-    // invert 0.07-0.14 s in at these spacings (2026-11-28, eighth: 0.136 s at 6 mm, 0.076 s at 5.5 mm; at 4.5 and
-    // 5 mm it now reaches 0.15 s, so those no longer serve here). The first case blows up and the bench goes on to
-    // the second.
+    // invert 0.06-0.12 s in at these spacings (2026-11-28, ninth, with the faces the broker now sends: 0.118 s at
+    // 6 mm, 0.067 s at 5.5 mm; eighth: 0.136 and 0.076 s; at 4.5 and 5 mm it reached 0.15 s, so those do not serve
+    // here). The first case blows up and the bench goes on to the second.
     let (output, out) = bench(
         "unstable",
         &[

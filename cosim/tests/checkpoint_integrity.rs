@@ -200,6 +200,7 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
         id: particles as u32 + 5,
         dx: [0.0; 2],
         dv: [0.0; 2],
+        face: None,
     });
     rewrite(&bad, "broker.bin", &bincode::serialize(&(tag, format, state)).unwrap());
     assert_refused(

@@ -38,6 +38,7 @@ fn bad_messages(run: &str, seed: u64) -> Vec<Vec<u8>> {
             id: 0,
             dx: [1.0, 1.0],
             dv: [100.0, 100.0],
+            face: None,
         }],
         roi: None,
         want_interface: true,

@@ -35,7 +35,7 @@ import tomllib
 
 import zenoh
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 
 
 # --- wire format (docs/PROTOCOL.md §3-§5) -------------------------------------------------------------------------
@@ -107,7 +107,8 @@ def read_command(payload, run):
         raise ValueError(f"protocol version {version}, expected {PROTOCOL_VERSION}")
     run_got, step, t = r.string(), r.u64(), r.f64()
     dt = r.f64()
-    corrections = r.seq(lambda: (r.u32(), r.take("<2d"), r.take("<2d")))
+    # Protocol 3: each correction may carry the structure's face (fluid corrections only; refused on a node's).
+    corrections = r.seq(lambda: (r.u32(), r.take("<2d"), r.take("<2d"), r.take("<4d") if r.boolean() else None))
     roi = r.take("<4d") if r.boolean() else None
     want_interface, want_snapshot, stop = r.boolean(), r.boolean(), r.boolean()
     if r.i != len(payload):
@@ -159,10 +160,12 @@ class RigidPlate:
 
     def apply(self, corrections):
         """Velocity corrections are impulses m_a dv_a on the body; position corrections shift it (mass-weighted)."""
-        for node_id, _, _ in corrections:
+        for node_id, _, _, face in corrections:
             if node_id >= len(self.masses):  # PROTOCOL.md §7: a correction for an unknown node is an error
                 raise ValueError(f"corrections: node {node_id} out of range ({len(self.masses)} nodes)")
-        for node_id, dx, dv in corrections:
+            if face is not None:  # PROTOCOL.md §7: faces come with the fluid's corrections only
+                raise ValueError(f"corrections: node {node_id} carries a face")
+        for node_id, dx, dv, _ in corrections:
             m = self.masses[node_id]
             for k in range(2):
                 self.v[k] += m * dv[k] / self.mass

@@ -51,11 +51,13 @@ fn clamped_nodes_stay_put_and_ignore_corrections() {
             id: fixed[1] as u32,
             dx: [1e-3, 0.0],
             dv: [1.0, 0.0],
+            face: None,
         },
         Correction {
             id: free as u32,
             dx: [0.0, 1e-4],
             dv: [0.0, 0.5],
+            face: None,
         },
     ])
     .unwrap();
@@ -66,11 +68,13 @@ fn clamped_nodes_stay_put_and_ignore_corrections() {
             id: free as u32,
             dx: [0.0, 1.0],
             dv: [0.0, 1.0],
+            face: None,
         },
         Correction {
             id: u32::MAX,
             dx: [1.0, 1.0],
             dv: [1.0, 1.0],
+            face: None,
         },
     ]);
     assert_eq!(
@@ -101,6 +105,7 @@ fn inverted_element_is_a_typed_error() {
         id: k as u32,
         dx: [-0.015, 0.03],
         dv: [0.0; 2],
+        face: None,
     }])
     .unwrap();
     match s.advance(1e-4) {

@@ -3,8 +3,8 @@
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 /// Protocol version this build speaks. 2: `SphSetup::sensors` and `SphSnapshot::sensors` (interval-mean pressure
-/// sensors).
-pub const PROTOCOL_VERSION: u32 = 2;
+/// sensors). 3: `Correction::face` (the structure's face behind a particle a `particle_particle` pass corrected).
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// `{protocol_version, run, step, t, body}`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

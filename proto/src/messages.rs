@@ -47,7 +47,8 @@ impl FemMesh {
     }
 }
 
-/// A sparse correction to one particle or node: position and velocity increments.
+/// A sparse correction to one particle or node: position and velocity increments, and for a fluid particle that a
+/// `particle_particle` pass corrected, the structure's face behind it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Correction {
     /// Node or particle id.
@@ -56,6 +57,22 @@ pub struct Correction {
     pub dx: [f64; 2],
     /// Velocity increment [m/s].
     pub dv: [f64; 2],
+    /// The structure's face nearest the corrected particle, where the correction does not show it: sent with the
+    /// fluid's corrections of a `particle_particle` pass, which changes velocities only (a `particle_element` pass
+    /// puts the particle r_c in front of the face along its normal, so its correction shows the face; ISPH reads it
+    /// from there). `None` on the structure's corrections.
+    pub face: Option<ContactFace>,
+}
+
+/// A face of the structure as seen from one fluid particle: the nearest point of its boundary and the unit normal
+/// there, out of the structure (a segment's outward normal; at a segment's end, the direction from that end to the
+/// particle).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactFace {
+    /// The nearest point of the structure's boundary [m].
+    pub point: [f64; 2],
+    /// Unit normal out of the structure, towards the particle.
+    pub normal: [f64; 2],
 }
 
 /// Topics `broker/fem` and `broker/sph` (broker → node, each step): corrections to apply, then the step to take.

@@ -1,7 +1,9 @@
 //! How the codec refuses a message (`docs/PROTOCOL.md` §7) and how it behaves on arbitrary input.
 
 use cosim_proto::keys::{key, topic, valid_run_id};
-use cosim_proto::messages::{Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand};
+use cosim_proto::messages::{
+    ContactFace, Correction, Energies, FemMesh, FemSnapshot, FemState, NodeError, Segment, StepCommand,
+};
 use cosim_proto::{CodecError, Envelope, PROTOCOL_VERSION};
 use proptest::prelude::*;
 
@@ -16,6 +18,7 @@ fn step_command() -> Envelope<StepCommand> {
                 id: 7,
                 dx: [1.0, -2.0],
                 dv: [0.0, 0.25],
+                face: None,
             }],
             roi: Some([0.0, 0.0, 1.0, 1.0]),
             want_interface: true,
@@ -66,7 +69,7 @@ fn another_protocol_version_is_refused_with_version() {
         matches!(err, CodecError::Version { what: "test", got } if got == PROTOCOL_VERSION + 1),
         "{err:?}"
     );
-    assert!(err.to_string().contains("protocol version 3"), "{err}");
+    assert!(err.to_string().contains("protocol version 4"), "{err}");
 }
 
 #[test]
@@ -83,12 +86,12 @@ fn another_version_is_reported_even_when_the_body_does_not_decode() {
         },
     )
     .encode();
-    bytes[0] = 3;
+    bytes[0] = 4;
     let err = Envelope::<StepCommand>::decode(&bytes, "r1", "test").unwrap_err();
-    assert!(matches!(err, CodecError::Version { got: 3, .. }), "{err:?}");
+    assert!(matches!(err, CodecError::Version { got: 4, .. }), "{err:?}");
     // Version is checked before the run.
     let err = Envelope::<StepCommand>::decode(&bytes, "other", "test").unwrap_err();
-    assert!(matches!(err, CodecError::Version { got: 3, .. }), "{err:?}");
+    assert!(matches!(err, CodecError::Version { got: 4, .. }), "{err:?}");
 }
 
 #[test]
@@ -231,13 +234,21 @@ fn vec2() -> impl Strategy<Value = [f64; 2]> {
 fn step_command_strategy() -> impl Strategy<Value = StepCommand> {
     (
         finite(),
-        prop::collection::vec((any::<u32>(), vec2(), vec2()), 0..8),
+        prop::collection::vec((any::<u32>(), vec2(), vec2(), prop::option::of((vec2(), vec2()))), 0..8),
         prop::option::of([finite(), finite(), finite(), finite()]),
         any::<(bool, bool, bool)>(),
     )
         .prop_map(|(dt, corr, roi, (want_interface, want_snapshot, stop))| StepCommand {
             dt,
-            corrections: corr.into_iter().map(|(id, dx, dv)| Correction { id, dx, dv }).collect(),
+            corrections: corr
+                .into_iter()
+                .map(|(id, dx, dv, face)| Correction {
+                    id,
+                    dx,
+                    dv,
+                    face: face.map(|(point, normal)| ContactFace { point, normal }),
+                })
+                .collect(),
             roi,
             want_interface,
             want_snapshot,
@@ -295,9 +306,14 @@ proptest! {
     ) {
         let env = Envelope::new(&run, step, t, body);
         let bytes = env.encode();
-        // Size formula of docs/PROTOCOL.md §5: header 28 + run bytes; body 8 + 8 + 36 per correction + roi + 3.
+        // Size formula of docs/PROTOCOL.md §5: header 28 + run bytes; body 8 + 8 + 37 per correction + 32 per face
+        // + roi + 3.
         let roi = if env.body.roi.is_some() { 33 } else { 1 };
-        prop_assert_eq!(bytes.len(), 28 + run.len() + 8 + 8 + 36 * env.body.corrections.len() + roi + 3);
+        let faces = env.body.corrections.iter().filter(|c| c.face.is_some()).count();
+        prop_assert_eq!(
+            bytes.len(),
+            28 + run.len() + 8 + 8 + 37 * env.body.corrections.len() + 32 * faces + roi + 3
+        );
         prop_assert_eq!(Envelope::<StepCommand>::decode(&bytes, &run, "test").unwrap(), env);
     }
 

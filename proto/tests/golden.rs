@@ -12,7 +12,7 @@
 use std::fmt::Debug;
 
 use cosim_proto::messages::{
-    Correction, Energies, FemMesh, FemSnapshot, FemState, NodeCheckpoint, NodeError, Segment, StepCommand,
+    ContactFace, Correction, Energies, FemMesh, FemSnapshot, FemState, NodeCheckpoint, NodeError, Segment, StepCommand,
 };
 use cosim_proto::{Envelope, PROTOCOL_VERSION};
 use serde::{de::DeserializeOwned, Serialize};
@@ -55,7 +55,7 @@ where
 
 /// The worked example of `docs/PROTOCOL.md` §6: the same hex, line for line.
 const STEP_COMMAND_DOC_EXAMPLE: &str = "
-    02 00 00 00                         # protocol_version u32 = 2
+    03 00 00 00                         # protocol_version u32 = 3
     02 00 00 00 00 00 00 00             # run: length u64 = 2
     72 31                               #      UTF-8 \"r1\"
     03 00 00 00 00 00 00 00             # step u64 = 3
@@ -67,6 +67,7 @@ const STEP_COMMAND_DOC_EXAMPLE: &str = "
     00 00 00 00 00 00 00 c0             #   [0].dx[1] f64 = -2.0
     00 00 00 00 00 00 00 00             #   [0].dv[0] f64 = 0.0
     00 00 00 00 00 00 d0 3f             #   [0].dv[1] f64 = 0.25
+    00                                  #   [0].face: Option tag 0 = None
     00                                  # body.roi: Option tag 0 = None
     01                                  # body.want_interface bool = true
     00                                  # body.want_snapshot bool = false
@@ -84,6 +85,7 @@ fn step_command_doc_example() -> Envelope<StepCommand> {
                 id: 7,
                 dx: [1.0, -2.0],
                 dv: [0.0, 0.25],
+                face: None,
             }],
             roi: None,
             want_interface: true,
@@ -94,16 +96,16 @@ fn step_command_doc_example() -> Envelope<StepCommand> {
 }
 
 #[test]
-fn protocol_version_is_2() {
-    // Every golden string below starts with `02 00 00 00`; bumping the version must revisit them all.
-    assert_eq!(PROTOCOL_VERSION, 2);
+fn protocol_version_is_3() {
+    // Every golden string below starts with `03 00 00 00`; bumping the version must revisit them all.
+    assert_eq!(PROTOCOL_VERSION, 3);
 }
 
 #[test]
-fn step_command_doc_example_is_86_bytes() {
-    // Header 4 + (8 + 2) + 8 + 8 = 30, body 8 + (8 + 1 × 36) + 1 + 3 = 56 (`docs/PROTOCOL.md` §6).
-    assert_eq!(hex(STEP_COMMAND_DOC_EXAMPLE).len(), 86);
-    assert_eq!(step_command_doc_example().encode().len(), 86);
+fn step_command_doc_example_is_87_bytes() {
+    // Header 4 + (8 + 2) + 8 + 8 = 30, body 8 + (8 + 1 × 37) + 1 + 3 = 57 (`docs/PROTOCOL.md` §6).
+    assert_eq!(hex(STEP_COMMAND_DOC_EXAMPLE).len(), 87);
+    assert_eq!(step_command_doc_example().encode().len(), 87);
 }
 
 #[test]
@@ -137,6 +139,55 @@ fn step_command_doc_example_golden() {
 }
 
 #[test]
+fn a_fluid_correction_with_its_face_golden() {
+    // Protocol version 3: the structure's face behind a particle a `particle_particle` pass corrected.
+    let env = Envelope::new(
+        "r1",
+        2,
+        0.25,
+        StepCommand {
+            dt: 0.0625,
+            corrections: vec![Correction {
+                id: 4,
+                dx: [0.0; 2],
+                dv: [0.0, 0.5],
+                face: Some(ContactFace {
+                    point: [1.0, -0.5],
+                    normal: [0.0, 1.0],
+                }),
+            }],
+            roi: None,
+            want_interface: false,
+            want_snapshot: false,
+            stop: false,
+        },
+    );
+    check_golden(
+        &env,
+        "
+        03 00 00 00                     # protocol_version = 3
+        02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
+        02 00 00 00 00 00 00 00         # step = 2
+        00 00 00 00 00 00 d0 3f         # t = 0.25
+        00 00 00 00 00 00 b0 3f         # dt = 0.0625
+        01 00 00 00 00 00 00 00         # corrections: count 1
+        04 00 00 00                     #   id = 4
+        00 00 00 00 00 00 00 00         #   dx[0] = 0.0
+        00 00 00 00 00 00 00 00         #   dx[1] = 0.0
+        00 00 00 00 00 00 00 00         #   dv[0] = 0.0
+        00 00 00 00 00 00 e0 3f         #   dv[1] = 0.5
+        01                              #   face: Some
+        00 00 00 00 00 00 f0 3f         #     point[0] = 1.0
+        00 00 00 00 00 00 e0 bf         #     point[1] = -0.5
+        00 00 00 00 00 00 00 00         #     normal[0] = 0.0
+        00 00 00 00 00 00 f0 3f         #     normal[1] = 1.0
+        00                              # roi = None
+        00 00 00                        # want_interface, want_snapshot, stop = false
+        ",
+    );
+}
+
+#[test]
 fn step_command_with_roi_and_stop_golden() {
     let env = Envelope::new(
         "r1",
@@ -154,7 +205,7 @@ fn step_command_with_roi_and_stop_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         09 00 00 00 00 00 00 00         # step = 9
         00 00 00 00 00 00 f0 3f         # t = 1.0
@@ -194,7 +245,7 @@ fn fem_mesh_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         00 00 00 00 00 00 00 00         # step = 0
         00 00 00 00 00 00 00 00         # t = 0.0
@@ -246,7 +297,7 @@ fn fem_state_without_snapshot_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         03 00 00 00 00 00 00 00         # step = 3
         00 00 00 00 00 00 e4 3f         # t = 0.625
@@ -292,7 +343,7 @@ fn fem_state_with_snapshot_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         04 00 00 00 00 00 00 00         # step = 4
         00 00 00 00 00 00 f0 3f         # t = 1.0
@@ -333,7 +384,7 @@ fn node_checkpoint_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         07 00 00 00 00 00 00 00         # step = 7
         00 00 00 00 00 00 e0 3f         # t = 0.5
@@ -359,7 +410,7 @@ fn node_error_golden() {
     check_golden(
         &env,
         "
-        02 00 00 00                     # protocol_version = 2
+        03 00 00 00                     # protocol_version = 3
         02 00 00 00 00 00 00 00 72 31   # run = \"r1\"
         05 00 00 00 00 00 00 00         # step = 5
         00 00 00 00 00 00 e0 3f         # t = 0.5
@@ -386,7 +437,7 @@ fn run_id_bytes_are_utf8_with_u64_length() {
     check_golden(
         &env,
         "
-        02 00 00 00
+        03 00 00 00
         07 00 00 00 00 00 00 00  72 75 6e 2d 41 5f 37    # \"run-A_7\"
         01 00 00 00 00 00 00 00
         00 00 00 00 00 00 00 00

@@ -23,7 +23,7 @@ fn hex(text: &str) -> Vec<u8> {
 const GOLDEN: &str = "
     43 4f 53 49 4d 54 52 43                 # magic `COSIMTRC`
     01 00 00 00                             # format u32 = 1
-    02 00 00 00                             # protocol_version u32 = 2
+    03 00 00 00                             # protocol_version u32 = 3
     # record 0: the scene
     16 00 00 00                             # len u32 = 22 = 10 + 12
     79 2f 86 33                             # crc32 = 33862f79
@@ -33,11 +33,11 @@ const GOLDEN: &str = "
     76 65 72 73 69 6f 6e 20 3d 20 31 0a     # `version = 1\\n`
     # record 1: a command to fem-node
     3c 00 00 00                             # len u32 = 60 = 10 + 50
-    d6 36 47 27                             # crc32 = 274736d6
+    27 2f 76 a3                             # crc32 = a3762f27
     04                                      # kind = 4 command
     01                                      # node = 1 fem-node
     03 00 00 00 00 00 00 00                 # step u64 = 3
-    02 00 00 00                             #   envelope: protocol_version = 2
+    03 00 00 00                             #   envelope: protocol_version = 3
     02 00 00 00 00 00 00 00 72 31           #   run = \"r1\"
     03 00 00 00 00 00 00 00                 #   step = 3
     00 00 00 00 00 00 e0 3f                 #   t = 0.5
@@ -68,7 +68,7 @@ fn command() -> Vec<u8> {
 
 /// The golden trace, written by the code.
 fn written() -> Vec<u8> {
-    let mut out = trace::header(2).to_vec();
+    let mut out = trace::header(3).to_vec();
     out.extend(trace::encode(Kind::Scene, Node::Broker, 0, b"version = 1\n").unwrap());
     out.extend(trace::encode(Kind::Command, Node::Fem, 3, &command()).unwrap());
     out.extend(trace::encode(Kind::End, Node::Broker, 3, b"{}").unwrap());
@@ -88,7 +88,7 @@ fn trace_bytes_are_the_documented_layout() {
 #[test]
 fn golden_trace_reads_back() {
     let t = trace::parse(&hex(GOLDEN)).unwrap();
-    assert_eq!(t.protocol_version, 2);
+    assert_eq!(t.protocol_version, 3);
     assert_eq!(t.torn, None);
     let kinds: Vec<_> = t.records.iter().map(|r| (r.kind, r.node, r.step)).collect();
     assert_eq!(
@@ -101,7 +101,7 @@ fn golden_trace_reads_back() {
     );
     assert_eq!(t.records[1].payload, command());
     let raw = RawEnvelope::split(&t.records[1].payload).unwrap();
-    assert_eq!((raw.protocol_version, raw.run, raw.step, raw.t), (2, "r1", 3, 0.5));
+    assert_eq!((raw.protocol_version, raw.run, raw.step, raw.t), (3, "r1", 3, 0.5));
     // Another run id: the header rebuilt, the body the same bytes.
     let moved = raw.for_run("replay-7");
     let back = Envelope::<StepCommand>::decode(&moved, "replay-7", "command").unwrap();

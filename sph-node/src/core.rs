@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use bincode::Options;
-use cosim_proto::messages::{Correction, SphSetup, SphSnapshot, SphState, StepCommand};
+use cosim_proto::messages::{ContactFace, Correction, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{FluidSolver as SceneSolver, PpeSourceKind, Scene};
 use serde::{Deserialize, Serialize};
 
@@ -200,6 +200,13 @@ impl SphCore {
                 state.x[i][k] += c.dx[k];
                 state.v[i][k] += c.dv[k];
             }
+        }
+        let faces: Vec<(usize, ContactFace)> = corrections
+            .iter()
+            .filter_map(|c| Some((c.id as usize, c.face?)))
+            .collect();
+        if !faces.is_empty() {
+            self.solver.contact_faces(&faces);
         }
         Ok(())
     }

@@ -6,6 +6,7 @@
 //! the method carries from one step to the next, in its own encoding. Nothing that a step rebuilds (neighbour
 //! lists, cell order, scratch) is saved: [`FluidSolver::restore`] rebuilds it as a step would.
 
+use cosim_proto::messages::ContactFace;
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 use crate::error::Result;
@@ -38,6 +39,11 @@ pub trait FluidSolver: Send + Sync {
     fn equal_substeps(&self) -> bool {
         false
     }
+    /// The structure's faces the broker sent with the corrections just applied (`Correction::face`: a
+    /// `particle_particle` pass, which changes velocities only), by particle id, for the step that follows them. A
+    /// method that does not use them (WCSPH: the structure acts on it through the contact alone) ignores them.
+    fn contact_faces(&mut self, _faces: &[(usize, ContactFace)]) {}
+
     /// Advances the fluid by `dt`. After an error the state is part-way through the step and should not be
     /// advanced further.
     fn step(&mut self, dt: f64) -> Result<()>;

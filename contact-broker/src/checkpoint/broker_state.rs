@@ -254,11 +254,13 @@ component = "x"
                 id: 5,
                 dx: [0.0, 1e-4],
                 dv: [0.0; 2],
+                face: None,
             }],
             pending_sph: vec![Correction {
                 id: 15,
                 dx: [1e-4, 0.0],
                 dv: [0.1, 0.0],
+                face: None,
             }],
             roi: Some([0.9, -0.1, 1.3, 0.2]),
             load: Some(vec![[0.0; 2]; 6]),

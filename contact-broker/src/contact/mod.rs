@@ -54,6 +54,7 @@
 mod algorithm;
 mod bodies;
 mod error;
+mod face;
 mod geometry;
 mod grid;
 mod pair;
@@ -63,6 +64,7 @@ mod particle_particle;
 pub use algorithm::{ContactAlgorithm, PassReport};
 pub use bodies::{Nodes, Particles, Segment};
 pub use error::ContactError;
+pub use face::nearest_face;
 pub use particle_element::{
     particle_element, particle_element_with, ContactPair, ContactParams, ContactReport, PairMaster, ParticleElement,
     ParticleElementWorkspace,

@@ -193,6 +193,7 @@ mod tests {
                 id: 3,
                 dx: [0.0, dx],
                 dv: [0.0; 2],
+                face: None,
             }],
             roi: None,
             want_interface: true,

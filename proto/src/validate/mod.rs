@@ -371,16 +371,41 @@ impl StepCommand {
         if let Some(roi) = &self.roi {
             c.points("roi", std::slice::from_ref(roi))?;
         }
-        validate_corrections(c, &self.corrections, count)
+        validate_corrections(c, &self.corrections, count, message == crate::keys::topic::BROKER_SPH)
     }
 }
 
-fn validate_corrections(c: Check, corrections: &[Correction], count: usize) -> Result {
+/// Corrections to `count` ids; faces only where `faces` (the fluid's corrections), with finite points and unit
+/// normals.
+fn validate_corrections(c: Check, corrections: &[Correction], count: usize, faces: bool) -> Result {
     for (k, corr) in corrections.iter().enumerate() {
         c.id("corrections.id", &[k], corr.id, count, "ids")?;
         for d in 0..2 {
             c.finite("corrections.dx", &[k, d], corr.dx[d])?;
             c.finite("corrections.dv", &[k, d], corr.dv[d])?;
+        }
+        let Some(face) = corr.face else { continue };
+        if !faces {
+            return Err(c.fail(
+                "corrections.face",
+                &[k],
+                "a face",
+                "faces come with the fluid's corrections only",
+            ));
+        }
+        for d in 0..2 {
+            c.finite("corrections.face.point", &[k, d], face.point[d])?;
+        }
+        let [nx, ny] = face.normal;
+        let len = nx.hypot(ny);
+        // A NaN length fails too.
+        if (len - 1.0).abs().is_nan() || (len - 1.0).abs() > 1e-9 {
+            return Err(c.fail(
+                "corrections.face.normal",
+                &[k],
+                format!("{:?}", face.normal),
+                "must be a unit vector",
+            ));
         }
     }
     Ok(())

@@ -1,6 +1,7 @@
 //! The content checks of each message type: what passes, and the one line naming what does not.
 
 use super::*;
+use crate::messages::ContactFace;
 
 fn mesh() -> FemMesh {
     FemMesh {
@@ -163,6 +164,7 @@ fn a_command_longer_than_max_dt_or_for_an_unknown_id_is_refused() {
             id: 3,
             dx: [0.0; 2],
             dv: [1.0, 0.0],
+            face: None,
         }],
         roi: None,
         want_interface: true,
@@ -184,4 +186,49 @@ fn a_command_longer_than_max_dt_or_for_an_unknown_id_is_refused() {
     );
     let nan = StepCommand { dt: f64::NAN, ..cmd };
     assert!(nan.validate("broker/sph", 4, 1e-4).is_err());
+}
+
+/// Protocol 3: a face comes with a fluid correction only, with a finite point and a unit normal.
+#[test]
+fn a_correction_s_face_is_checked() {
+    let with = |face: ContactFace| StepCommand {
+        dt: 1e-4,
+        corrections: vec![Correction {
+            id: 1,
+            dx: [0.0; 2],
+            dv: [0.0, 0.1],
+            face: Some(face),
+        }],
+        roi: None,
+        want_interface: true,
+        want_snapshot: false,
+        stop: false,
+    };
+    let good = ContactFace {
+        point: [0.5, 0.0],
+        normal: [0.6, 0.8],
+    };
+    assert_eq!(with(good).validate("broker/sph", 2, 1e-4), Ok(()));
+    assert_eq!(
+        with(good).validate("broker/fem", 2, 1e-4).unwrap_err().to_string(),
+        "broker/fem corrections.face[0] = a face: faces come with the fluid's corrections only"
+    );
+    let long = ContactFace {
+        normal: [0.6, 0.9],
+        ..good
+    };
+    assert_eq!(
+        with(long).validate("broker/sph", 2, 1e-4).unwrap_err().to_string(),
+        "broker/sph corrections.face.normal[0] = [0.6, 0.9]: must be a unit vector"
+    );
+    let nan = ContactFace {
+        point: [f64::NAN, 0.0],
+        ..good
+    };
+    assert!(with(nan).validate("broker/sph", 2, 1e-4).is_err());
+    let nan_normal = ContactFace {
+        normal: [f64::NAN, 1.0],
+        ..good
+    };
+    assert!(with(nan_normal).validate("broker/sph", 2, 1e-4).is_err());
 }

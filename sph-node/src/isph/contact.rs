@@ -32,6 +32,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use cosim_proto::messages::ContactFace;
+
 use crate::kernel::CubicSpline;
 use crate::neighbors::NeighborList;
 use crate::particles::{separation, FluidState, ParticleView};
@@ -128,6 +130,11 @@ pub struct ContactLayer {
     flags: Vec<bool>,
     /// Particles corrected before this step.
     corrected: usize,
+    /// The faces the broker sent with the corrections before this step (`particle_particle`), by particle id,
+    /// ascending: taken by the next [`ContactLayer::detect`] in place of the face a correction would reveal.
+    /// Never held between two steps, so not in a checkpoint.
+    #[serde(skip)]
+    given: Vec<(usize, Face)>,
 }
 
 impl ContactLayer {
@@ -137,6 +144,29 @@ impl ContactLayer {
         self.x_end.extend_from_slice(&state.x);
         self.v_end.clear();
         self.v_end.extend_from_slice(&state.v);
+    }
+
+    /// Holds the structure's `faces` the broker sent with the corrections before this step, by particle id, for the
+    /// next [`ContactLayer::detect`]. A `particle_particle` pass changes velocities only, by a force that acts
+    /// within r_c of the structure's boundary points: where its correction leaves a particle says nothing of the
+    /// face, and the face inferred from it (x − r_c n, with n the velocity change's direction) wandered with the
+    /// particle; its travel, read as the face's velocity, drained the hydrostatic plate's pressure (docs/CORRECTIONS.md
+    /// "ISPH + `particle_particle`"). A given face stands still in the PPE (velocity 0): the structure's motion
+    /// reaches the fluid through the face's position, taken anew at each correction, and its momentum through the
+    /// force.
+    pub fn give(&mut self, faces: &[(usize, ContactFace)]) {
+        self.given.clear();
+        self.given.extend(faces.iter().map(|&(i, f)| {
+            let offset = f.normal[0] * f.point[0] + f.normal[1] * f.point[1];
+            let face = Face {
+                normal: f.normal,
+                offset,
+                velocity: 0.0,
+            };
+            (i, face)
+        }));
+        // The broker sends them in id order; a stable sort keeps the first of an id sent twice first.
+        self.given.sort_by_key(|&(i, _)| i);
     }
 
     /// Compares `state` with the end of the last step: a particle whose position or velocity changed in between was
@@ -165,13 +195,28 @@ impl ContactLayer {
         }
         let r_c = 0.5 * dx;
         let mut corrected = 0;
+        let given = std::mem::take(&mut self.given);
+        let mut given_at = given.iter().peekable();
         for i in 0..n {
             let (x, v) = (state.x[i], state.v[i]);
             let d_x = [x[0] - self.x_end[i][0], x[1] - self.x_end[i][1]];
             let d_v = [v[0] - self.v_end[i][0], v[1] - self.v_end[i][1]];
             let dir = if d_x != [0.0; 2] { d_x } else { d_v };
             let len = dir[0].hypot(dir[1]);
-            if len > 0.0 {
+            while given_at.next_if(|&&(j, _)| j < i).is_some() {}
+            let given_face = given_at.next_if(|&&(j, _)| j == i).map(|&(_, f)| f);
+            if let (Some(face), true) = (given_face, len > 0.0) {
+                // The structure's face, as the broker sent it (see `give`).
+                self.face[i] = face;
+                self.point[i] = [
+                    x[0] - face.distance(x) * face.normal[0],
+                    x[1] - face.distance(x) * face.normal[1],
+                ];
+                self.measured[i] = false;
+                self.time[i] = state.t;
+                self.age[i] = 0;
+                corrected += 1;
+            } else if len > 0.0 {
                 let normal = [dir[0] / len, dir[1] / len];
                 let point = [x[0] - r_c * normal[0], x[1] - r_c * normal[1]];
                 // The face moved along n by n · (q − q_old) since the last correction of this particle against the
@@ -381,90 +426,4 @@ pub fn face_normal_velocity(u: [f64; 2], face: &Face, dt: f64, gravity: [f64; 2]
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A layer read back from a checkpoint: its records are one per particle or none, its end the state's.
-    #[test]
-    fn a_restored_layer_is_checked_against_its_state() {
-        let state = FluidState {
-            x: vec![[0.0, 0.0], [0.01, 0.0]],
-            v: vec![[0.0; 2]; 2],
-            rho: vec![1000.0; 2],
-            p: vec![0.0; 2],
-            m: vec![0.1; 2],
-            ..FluidState::default()
-        };
-        let mut layer = ContactLayer::default();
-        layer.record_end(&state);
-        assert_eq!(layer.check(&state), Ok(()));
-        let mut moved = state.clone();
-        moved.v[1] = [0.0, -0.1];
-        layer.detect(&moved, 0.01);
-        layer.record_end(&moved);
-        assert_eq!(layer.check(&moved), Ok(()), "records made by a correction");
-        let mut short = layer.clone();
-        short.face.pop();
-        assert_eq!(
-            short.check(&moved),
-            Err("contact.face holds 1 records (contact.age 2), there are 2 fluid particles".into())
-        );
-        let mut bad = layer.clone();
-        bad.time[0] = f64::NAN;
-        assert_eq!(bad.check(&moved), Err("contact.time[0] = NaN is not finite".into()));
-        assert_eq!(
-            layer.check(&state),
-            Err("contact.v_end[1] = [0.0, -0.1] where state.v has [0.0, 0.0]".into())
-        );
-    }
-
-    #[test]
-    fn half_space_of_the_default_kernel() {
-        let dx = 0.01;
-        let kernel = CubicSpline::new(1.3 * dx);
-        let (div_r, w_sum) = half_space(&kernel, dx, 0.5 * dx);
-        // Full lattice: ∇·r = 2.02, Shepard sum 1.0; first layer of a half lattice: 1.28 and 0.76.
-        assert!((div_r - 0.743).abs() < 0.01, "{div_r}");
-        assert!((w_sum - 0.237).abs() < 0.01, "{w_sum}");
-        let (far, _) = half_space(&kernel, dx, 2.0 * dx);
-        assert!(far < 0.01 && far < div_r, "{far}");
-    }
-
-    #[test]
-    fn a_layer_never_corrected_holds_no_records_and_the_first_correction_makes_them() {
-        let dx = 0.01;
-        let mut state = FluidState {
-            t: 0.0,
-            step: 0,
-            x: vec![[0.0, 0.0], [dx, 0.0], [2.0 * dx, 0.0]],
-            v: vec![[0.0; 2]; 3],
-            rho: vec![1000.0; 3],
-            p: vec![0.0; 3],
-            m: vec![0.1; 3],
-        };
-        let mut layer = ContactLayer::default();
-        for _ in 0..3 {
-            layer.detect(&state, dx);
-            layer.record_end(&state);
-            state.t += 1e-3;
-        }
-        assert!(!layer.any() && layer.face(1).is_none() && layer.corrected() == 0);
-        assert_eq!(
-            layer.age.len() + layer.face.len() + layer.flags.len(),
-            0,
-            "records held before any correction"
-        );
-        // The contact puts particle 1 back along +y by 1e-4 m: it is against a face with normal +y, Δx/2 below it.
-        state.x[1][1] += 1e-4;
-        layer.detect(&state, dx);
-        assert_eq!((layer.corrected(), layer.age.len()), (1, 3));
-        let face = layer.face(1).expect("particle 1 against a face");
-        assert_eq!(face.normal, [0.0, 1.0]);
-        assert!(
-            (face.distance(state.x[1]) - 0.5 * dx).abs() < 1e-15,
-            "{}",
-            face.distance(state.x[1])
-        );
-        assert!(layer.face(0).is_none() && layer.face(2).is_none());
-    }
-}
+mod tests;

@@ -1,5 +1,7 @@
 //! The ISPH solver as the node drives it: [`crate::FluidSolver`].
 
+use cosim_proto::messages::ContactFace;
+
 use super::IsphSolver;
 use crate::error::Result;
 use crate::fluid_solver::{FluidSolver, SavedSolver};
@@ -35,6 +37,11 @@ impl FluidSolver for IsphSolver {
 
     fn stable_dt(&self) -> f64 {
         IsphSolver::stable_dt(self)
+    }
+
+    /// Held for the next step's [`crate::isph::contact::ContactLayer::detect`].
+    fn contact_faces(&mut self, faces: &[(usize, ContactFace)]) {
+        self.contact.give(faces);
     }
 
     fn step(&mut self, dt: f64) -> Result<()> {
