@@ -244,7 +244,11 @@ fn nearest_segment(mesh: &FemMesh, x: &[[f64; 2]], p: [f64; 2]) -> Option<Neares
 fn correction_of(list: &[Correction], id: u32) -> serde_json::Value {
     list.iter()
         .find(|c| c.id == id)
-        .map_or(serde_json::Value::Null, |c| json!({"dx": c.dx, "dv": c.dv}))
+        .map_or(serde_json::Value::Null, |c| match c.face {
+            // particle_particle: the structure's face the broker sent with the correction (protocol 3).
+            Some(f) => json!({"dx": c.dx, "dv": c.dv, "face": {"point": f.point, "normal": f.normal}}),
+            None => json!({"dx": c.dx, "dv": c.dv}),
+        })
 }
 
 fn head(look: &Look) -> serde_json::Value {
@@ -326,4 +330,37 @@ pub fn node(look: &Look, id: u32) -> anyhow::Result<serde_json::Value> {
         "correction": correction_of(&look.debug.fem_corrections, id),
     });
     Ok(doc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cosim_proto::messages::ContactFace;
+
+    /// A particle's last correction as `inspect --particle` shows it: with the face a `particle_particle` pass sent.
+    #[test]
+    fn a_correction_shows_its_face() {
+        let plain = Correction {
+            id: 3,
+            dx: [1e-4, 0.0],
+            dv: [0.0; 2],
+            face: None,
+        };
+        let with_face = Correction {
+            id: 5,
+            dx: [0.0; 2],
+            dv: [0.0, 0.5],
+            face: Some(ContactFace {
+                point: [0.1, 0.0],
+                normal: [0.0, 1.0],
+            }),
+        };
+        let list = [plain, with_face];
+        assert_eq!(correction_of(&list, 3), json!({"dx": [1e-4, 0.0], "dv": [0.0, 0.0]}));
+        assert_eq!(
+            correction_of(&list, 5),
+            json!({"dx": [0.0, 0.0], "dv": [0.0, 0.5], "face": {"point": [0.1, 0.0], "normal": [0.0, 1.0]}})
+        );
+        assert_eq!(correction_of(&list, 4), serde_json::Value::Null);
+    }
 }
