@@ -3,17 +3,22 @@
 
 use super::*;
 
-/// A layer read back from a checkpoint: its records are one per particle or none, its end the state's.
-#[test]
-fn a_restored_layer_is_checked_against_its_state() {
-    let state = FluidState {
-        x: vec![[0.0, 0.0], [0.01, 0.0]],
+/// Two particles at rest, `dx` apart on the x axis, at t = 0.
+fn row_of_two(dx: f64) -> FluidState {
+    FluidState {
+        x: vec![[0.0, 0.0], [dx, 0.0]],
         v: vec![[0.0; 2]; 2],
         rho: vec![1000.0; 2],
         p: vec![0.0; 2],
         m: vec![0.1; 2],
         ..FluidState::default()
-    };
+    }
+}
+
+/// A layer read back from a checkpoint: its records are one per particle or none, its end the state's.
+#[test]
+fn a_restored_layer_is_checked_against_its_state() {
+    let state = row_of_two(0.01);
     let mut layer = ContactLayer::default();
     layer.record_end(&state);
     assert_eq!(layer.check(&state), Ok(()));
@@ -42,14 +47,7 @@ fn a_restored_layer_is_checked_against_its_state() {
 #[test]
 fn a_given_face_replaces_the_inferred_one_for_one_step() {
     let dx = 0.01;
-    let mut state = FluidState {
-        x: vec![[0.0, 0.0], [dx, 0.0]],
-        v: vec![[0.0; 2]; 2],
-        rho: vec![1000.0; 2],
-        p: vec![0.0; 2],
-        m: vec![0.1; 2],
-        ..FluidState::default()
-    };
+    let mut state = row_of_two(dx);
     let mut layer = ContactLayer::default();
     layer.record_end(&state);
     // The force turned particle 1's velocity by (0.02, 0.1); the structure's face lies 0.3 Δx below it.
