@@ -250,18 +250,15 @@ impl Interface {
         stats.angular_momentum_change = ang;
         // The face behind a corrected particle, at the corrected positions, where the correction does not show it.
         let face = |k: usize| {
+            if !self.faces {
+                return None;
+            }
             let (point, normal) = contact::nearest_face(&self.segments, &nx, *px.get(k)?)?;
             Some(ContactFace { point, normal })
         };
         let corrections = Corrections {
             fem: diff(&self.node_ids, (&fem.x, &fem.v), (&nx, &nv), |_| None),
-            sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv), |k| {
-                if self.faces {
-                    face(k)
-                } else {
-                    None
-                }
-            }),
+            sph: diff(&sph.ids, (&sph.x, &sph.v), (&px, &pv), face),
         };
         Ok((corrections, stats))
     }

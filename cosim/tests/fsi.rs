@@ -195,6 +195,20 @@ fn elastic_gate_peak_and_convergence() {
     );
 }
 
+/// Runs `scene` with `sets` as three processes and in-process, asserts that both wrote the same probes byte for
+/// byte and that the first ran as processes, and returns the two output folders (processes first).
+fn twins(name: &str, scene: &str, sets: &[&str]) -> (Scratch, Scratch) {
+    let a = run(&format!("{name}_processes"), scene, sets, true);
+    let b = run(&format!("{name}_in_process"), scene, sets, false);
+    let (pa, pb) = (
+        std::fs::read(a.join("probes.csv")).unwrap(),
+        std::fs::read(b.join("probes.csv")).unwrap(),
+    );
+    assert_eq!(pa, pb, "{name}: in-process differs from processes");
+    assert_eq!(json(&a.join("summary.json"))["mode"], "processes");
+    (a, b)
+}
+
 /// ISPH + `particle_particle` as three processes gives the probes of its in-process twin byte for byte: the faces
 /// the broker sends with the corrections (protocol 3) cross the wire unchanged (~7 s).
 #[test]
@@ -204,14 +218,7 @@ fn isph_particle_particle_plate_replays_in_process_bit_for_bit() {
         "contact.algorithm=particle_particle",
         "run.end_time=0.03",
     ];
-    let a = run("plate_pp_processes", "scenes/hydrostatic_plate.toml", &sets, true);
-    let b = run("plate_pp_in_process", "scenes/hydrostatic_plate.toml", &sets, false);
-    let (pa, pb) = (
-        std::fs::read(a.join("probes.csv")).unwrap(),
-        std::fs::read(b.join("probes.csv")).unwrap(),
-    );
-    assert_eq!(pa, pb, "in-process differs from processes");
-    assert_eq!(json(&a.join("summary.json"))["mode"], "processes");
+    let (a, _) = twins("plate_pp", "scenes/hydrostatic_plate.toml", &sets);
     // The faces took part: the plate still carries the column at t = 0.025–0.03 s (measured −19.1 and −18.1 kN/m
     // against −19.6; without them the PPE's solution went ≤ 0 at 0.025 s and the load fell to −16.1 and −1.9 kN/m,
     // 54 % short on average, docs/CORRECTIONS.md "ISPH + `particle_particle`").
@@ -222,15 +229,8 @@ fn isph_particle_particle_plate_replays_in_process_bit_for_bit() {
 #[test]
 fn coarse_gate_replays_in_process_bit_for_bit() {
     let sets = ["run.end_time=0.03", "fluid.spacing=0.004"];
-    let a = run("gate_processes", "scenes/elastic_gate.toml", &sets, true);
-    let b = run("gate_in_process", "scenes/elastic_gate.toml", &sets, false);
-    let (pa, pb) = (
-        std::fs::read(a.join("probes.csv")).unwrap(),
-        std::fs::read(b.join("probes.csv")).unwrap(),
-    );
-    assert_eq!(pa, pb, "in-process differs from processes");
+    let (a, b) = twins("gate", "scenes/elastic_gate.toml", &sets);
     let s = json(&a.join("summary.json"));
-    assert_eq!(s["mode"], "processes");
     // What the nodes counted reaches the summary, the same in both modes: the fluid's sizes and its wall guard.
     let counts = &s["counts"];
     assert_eq!(

@@ -65,8 +65,8 @@ pub struct Correction {
 }
 
 /// A face of the structure as seen from one fluid particle: the nearest point of its boundary and the unit normal
-/// there, out of the structure (a segment's outward normal; at a segment's end, the direction from that end to the
-/// particle).
+/// there, out of the structure (the outward normal of the segment that point lies on; at a convex corner, of the
+/// segment the particle lies further in front of).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContactFace {
     /// The nearest point of the structure's boundary [m].

@@ -396,10 +396,9 @@ fn validate_corrections(c: Check, corrections: &[Correction], count: usize, face
         for d in 0..2 {
             c.finite("corrections.face.point", &[k, d], face.point[d])?;
         }
-        let [nx, ny] = face.normal;
-        let len = nx.hypot(ny);
+        let off = (face.normal[0].hypot(face.normal[1]) - 1.0).abs();
         // A NaN length fails too.
-        if (len - 1.0).abs().is_nan() || (len - 1.0).abs() > 1e-9 {
+        if off.is_nan() || off > 1e-9 {
             return Err(c.fail(
                 "corrections.face.normal",
                 &[k],

@@ -208,10 +208,8 @@ impl ContactLayer {
             if let (Some(face), true) = (given_face, len > 0.0) {
                 // The structure's face, as the broker sent it (see `give`).
                 self.face[i] = face;
-                self.point[i] = [
-                    x[0] - face.distance(x) * face.normal[0],
-                    x[1] - face.distance(x) * face.normal[1],
-                ];
+                let d = face.distance(x);
+                self.point[i] = [x[0] - d * face.normal[0], x[1] - d * face.normal[1]];
                 self.measured[i] = false;
                 self.time[i] = state.t;
                 self.age[i] = 0;
