@@ -7,6 +7,7 @@ use cosim_proto::messages::{ContactFace, Correction, FemMesh, FemState, SphSetup
 use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
 use crate::contact::{self, ContactAlgorithm};
+use crate::relaxation::{self, Relaxation};
 
 /// What one contact pass did, for `summary.json` `contact_stats` and the frames.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -53,6 +54,8 @@ pub struct Interface {
     recorded: bool,
     /// Send the structure's face with each fluid correction (`particle_particle`, whose corrections do not show it).
     faces: bool,
+    /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
+    relaxation: Relaxation,
 }
 
 impl Interface {
@@ -95,15 +98,22 @@ impl Interface {
             .collect();
         let dx = sph.spacing;
         let thickness = scene.contact.thickness.unwrap_or(0.5 * dx);
+        let force = particle_params(scene, dx, thickness);
         let algorithm: Box<dyn ContactAlgorithm> = match scene.contact.algorithm {
             ContactChoice::ParticleElement => {
                 Box::new(contact::ParticleElement::new(element_params(scene, dx, thickness)))
             }
-            ContactChoice::ParticleParticle => {
-                Box::new(contact::ParticleParticle::new(particle_params(scene, dx, thickness)))
-            }
+            ContactChoice::ParticleParticle => Box::new(contact::ParticleParticle::new(force)),
             ContactChoice::None => Box::new(()),
         };
+        let choice = relaxation::choose(scene, &force);
+        if choice.omega < 1.0 || choice.lag > 0.0 {
+            tracing::info!(
+                "contact reaction relaxation ω = {:.4} ({})",
+                choice.omega,
+                choice.reason
+            );
+        }
         Ok(Self {
             algorithm,
             node_ids,
@@ -118,6 +128,7 @@ impl Interface {
             records: Vec::new(),
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
+            relaxation: Relaxation::new(choice.omega, choice.lag),
         })
     }
 
@@ -163,6 +174,17 @@ impl Interface {
         self.impulse.iter().map(|j| [j[0] * k, j[1] * k]).collect()
     }
 
+    /// The impulse owed to each interface node and not yet given (empty unless the reaction is relaxed), for a
+    /// checkpoint.
+    pub fn owed(&self) -> &[[f64; 2]] {
+        self.relaxation.owed()
+    }
+
+    /// Put back the owed impulse a checkpoint saved ([`Interface::owed`]).
+    pub fn restore_owed(&mut self, owed: &[[f64; 2]]) -> anyhow::Result<()> {
+        self.relaxation.restore(owed, self.node_ids.len())
+    }
+
     /// One contact pass (§3 step 4) on the states both nodes answered after a step of length `dt`.
     pub fn pass(&mut self, fem: &FemState, sph: &SphState, dt: f64) -> anyhow::Result<(Corrections, PassStats)> {
         // The coordinator checked both states (FemState::validate, SphState::validate); a pass called without that
@@ -193,7 +215,9 @@ impl Interface {
         };
         self.records.clear();
         self.recorded = self.algorithm.pairs().is_some();
-        if !self.active() || sph.ids.is_empty() {
+        // Without particles nothing changes, unless the structure is still owed an impulse.
+        let owed = self.relaxation.owed().iter().any(|o| *o != [0.0; 2]);
+        if !self.active() || (sph.ids.is_empty() && !owed) {
             return Ok((Corrections::default(), stats));
         }
         let (mut px, mut pv) = (sph.x.clone(), sph.v.clone());
@@ -215,6 +239,17 @@ impl Interface {
             stats.max_penetration = report.max_penetration;
             report.node_impulse
         };
+        // Of the pass: the balance of the momentum it moved, before the structure's share is relaxed.
+        let (lin, ang) = momentum_change((&sph.m, &sph.v, &px, &pv), &nx, &node_impulse);
+        stats.linear_momentum_change = lin;
+        stats.angular_momentum_change = ang;
+        let mut node_impulse = node_impulse;
+        let change = self.relaxation.give(&mut node_impulse, &self.fixed, dt);
+        for ((v, c), m) in nv.iter_mut().zip(&change).zip(&self.masses) {
+            if *c != [0.0; 2] {
+                *v = [v[0] + c[0] / m, v[1] + c[1] / m];
+            }
+        }
         if let Some(pairs) = self.algorithm.pairs() {
             for p in pairs {
                 let Some(&particle) = sph.ids.get(p.particle) else {
@@ -245,9 +280,6 @@ impl Interface {
                 *slot = *j;
             }
         }
-        let (lin, ang) = momentum_change((&sph.m, &sph.v, &px, &pv), &nx, &node_impulse);
-        stats.linear_momentum_change = lin;
-        stats.angular_momentum_change = ang;
         // The face behind a corrected particle, at the corrected positions, where the correction does not show it.
         let face = |k: usize| {
             if !self.faces {

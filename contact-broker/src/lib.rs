@@ -1,7 +1,8 @@
 //! Contact algorithms and the step coordinator of the FEM–SPH co-simulation.
 //!
-//! `coordinator`, `probes`, `summary` and `output` are pure (files, no messaging); `setup` is the set-up of a run
-//! that `cosim run` and the `contact-broker` binary share; `transport` is the zenoh adapter used by the binary.
+//! `coordinator`, `interface`, `relaxation`, `probes`, `summary` and `output` are pure (files, no messaging);
+//! `setup` is the set-up of a run that `cosim run` and the `contact-broker` binary share; `transport` is the zenoh
+//! adapter used by the binary.
 #![warn(missing_docs)]
 
 pub mod checkpoint;
@@ -12,6 +13,7 @@ pub mod link;
 pub mod output;
 pub mod probes;
 pub mod recorder;
+pub mod relaxation;
 pub mod remote_control;
 pub mod setup;
 pub mod summary;

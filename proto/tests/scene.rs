@@ -163,3 +163,34 @@ fn frame_interval_is_a_whole_multiple_of_the_output_interval() {
     }
     assert!(err(SCENE, &["run.frame_interval=0.25"]).contains("not a whole multiple of run.output_interval (0.1 s)"));
 }
+
+/// `contact.reaction_relaxation`: in (0, 1], with `particle_particle` only; absent from the resolved scene unless
+/// given, so scenes and checkpoints written before it read the same.
+#[test]
+fn reaction_relaxation_is_a_fraction_for_particle_particle_only() {
+    let pp = "contact.algorithm=particle_particle";
+    let s = parse(
+        "f.toml",
+        SCENE,
+        &[pp.to_string(), "contact.reaction_relaxation=0.1".into()],
+    )
+    .unwrap();
+    assert_eq!(s.contact.reaction_relaxation, Some(0.1));
+    assert!(s.to_toml().contains("reaction_relaxation = 0.1"));
+    assert!(!parse("f.toml", SCENE, &[])
+        .unwrap()
+        .to_toml()
+        .contains("reaction_relaxation"));
+    for bad in ["0", "1.5", "-0.1", "nan"] {
+        let e = err(SCENE, &[pp, &format!("contact.reaction_relaxation={bad}")]);
+        assert!(
+            e.contains("f.toml") && e.contains("contact.reaction_relaxation") && e.contains("(0, 1]"),
+            "{bad}: {e}"
+        );
+    }
+    let e = err(SCENE, &["contact.reaction_relaxation=0.5"]);
+    assert!(
+        e.contains("contact.reaction_relaxation") && e.contains("\"particle_particle\" only"),
+        "{e}"
+    );
+}

@@ -34,6 +34,9 @@ pub struct BrokerState {
     pub load: Option<Vec<[f64; 2]>>,
     /// The contact impulse per solid since the last sample (`interface_load` probes).
     pub load_log: LoadLog,
+    /// The contact impulse owed to each interface node and not yet given (`contact.reaction_relaxation`); empty
+    /// where none is.
+    pub owed: Vec<[f64; 2]>,
     /// Fluid particles exchanged over the run.
     pub exchanged: u64,
     /// Fluid positions of the first sample (potential energy probes).
@@ -132,6 +135,12 @@ impl BrokerState {
                 self.load_log.impulse[k]
             ));
         }
+        if let Some(k) = self.owed.iter().position(|j| !finite(j)) {
+            return Err(format!("owed[{k}] = {:?} is not finite", self.owed[k]));
+        }
+        ensure(self.owed.len() as u64 <= fem_nodes, || {
+            format!("owed holds {} nodes, the structure has {fem_nodes}", self.owed.len())
+        })?;
         if let Some(x0) = &self.fluid_origin {
             ensure(x0.len() as u64 == particles, || {
                 format!(
@@ -265,6 +274,7 @@ component = "x"
             roi: Some([0.9, -0.1, 1.3, 0.2]),
             load: Some(vec![[0.0; 2]; 6]),
             load_log: LoadLog::default(),
+            owed: Vec::new(),
             exchanged: 40,
             fluid_origin: Some(vec![[0.05, 0.05]; 16]),
             rows: vec![(0.0, vec![0.4]), (0.1, vec![0.45]), (0.2, vec![0.5])],
@@ -351,5 +361,9 @@ component = "x"
         assert_eq!(e, "t = inf is not a time");
         let e = refused(|s| s.summary.steps = 11);
         assert_eq!(e, "summary.steps = 11 where step = 10");
+        let e = refused(|s| s.owed = vec![[0.0, f64::NAN]]);
+        assert_eq!(e, "owed[0] = [0.0, NaN] is not finite");
+        let e = refused(|s| s.owed = vec![[0.0; 2]; 7]);
+        assert_eq!(e, "owed holds 7 nodes, the structure has 6");
     }
 }

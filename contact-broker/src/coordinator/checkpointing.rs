@@ -81,6 +81,7 @@ pub(super) fn save_if_due(
         roi: contact.roi,
         load: contact.load.clone(),
         load_log: contact.since.clone(),
+        owed: contact.owed().to_vec(),
         exchanged: contact.exchanged,
         fluid_origin: run.outputs.probes.fluid_origin().map(<[_]>::to_vec),
         rows: run.outputs.csv.rows().to_vec(),
@@ -134,6 +135,7 @@ pub(super) fn resume(
     };
     (contact.roi, contact.load, contact.exchanged) = (saved.roi, saved.load.clone(), saved.exchanged);
     contact.since = saved.load_log.clone();
+    contact.restore_owed(&saved.owed)?;
     outputs.resume(saved)?;
     summary.continue_from(&saved.summary);
     Ok(())

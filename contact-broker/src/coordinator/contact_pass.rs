@@ -67,6 +67,23 @@ impl ContactPass {
         self.interface.as_ref().and_then(|i| i.contacts())
     }
 
+    /// The contact impulse owed to the structure's interface nodes ([`Interface::owed`]); empty without one.
+    pub fn owed(&self) -> &[[f64; 2]] {
+        self.interface.as_ref().map_or(&[], |i| i.owed())
+    }
+
+    /// Put back the owed impulse a checkpoint saved; refused unless empty or one per interface node.
+    pub fn restore_owed(&mut self, owed: &[[f64; 2]]) -> anyhow::Result<()> {
+        match self.interface.as_mut() {
+            Some(i) => i.restore_owed(owed).context("checkpoint broker.bin owed"),
+            None if owed.is_empty() => Ok(()),
+            None => anyhow::bail!(
+                "checkpoint broker.bin owed: {} impulses, but the run has no interface",
+                owed.len()
+            ),
+        }
+    }
+
     /// The commands of the next step, (fem, sph), carrying the pending corrections and the region of interest.
     pub fn commands(&mut self, dt: f64, want_snapshot: bool) -> (StepCommand, StepCommand) {
         let coupled = self.interface.is_some();

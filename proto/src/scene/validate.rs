@@ -3,7 +3,9 @@
 
 use std::collections::HashSet;
 
-use super::schema::{BoxSpec, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, SCENE_VERSION};
+use super::schema::{
+    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, SCENE_VERSION,
+};
 use super::sizing::Sizing;
 use crate::overlap;
 
@@ -209,6 +211,23 @@ impl Scene {
             || "contact.sweeps".into(),
             || "must be at least 1".into(),
         )?;
+        if let Some(w) = self.contact.reaction_relaxation {
+            check(
+                w > 0.0 && w <= 1.0,
+                || "contact.reaction_relaxation".into(),
+                || format!("must be in (0, 1], got {w}"),
+            )?;
+            check(
+                self.contact.algorithm == ContactAlgorithm::ParticleParticle,
+                || "contact.reaction_relaxation".into(),
+                || {
+                    format!(
+                        "applies to contact.algorithm = \"particle_particle\" only, not \"{}\"",
+                        self.contact.algorithm.name()
+                    )
+                },
+            )?;
+        }
         if let Some(fluid) = &self.fluid {
             validate_fluid(fluid, &self.walls, &self.solids)?;
         }

@@ -45,6 +45,12 @@ pub struct ContactSpec {
     /// had (the hydrostatic plate inverts an element within 120 steps with it on).
     #[serde(default)]
     pub move_structure: bool,
+    /// `particle_particle` only: the fraction ω ∈ (0, 1] of the contact impulse it is owed that each structure
+    /// node receives per coupling step (the rest later), against the added-mass instability of the explicit
+    /// coupling with ISPH. Default: 1 (all at once) with WCSPH; with ISPH 1/(1 + r), r the largest added-mass
+    /// ratio of the scene's solids (`contact-broker/src/relaxation.rs`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reaction_relaxation: Option<f64>,
 }
 
 fn default_algorithm() -> ContactAlgorithm {
@@ -62,6 +68,7 @@ impl Default for ContactSpec {
             thickness: None,
             sweeps: default_sweeps(),
             move_structure: false,
+            reaction_relaxation: None,
         }
     }
 }
