@@ -56,6 +56,8 @@ pub struct Interface {
     faces: bool,
     /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
     relaxation: Relaxation,
+    /// How `relaxation` was chosen; `None` where every impulse is given at once.
+    relaxation_choice: Option<relaxation::RelaxationChoice>,
 }
 
 impl Interface {
@@ -129,6 +131,7 @@ impl Interface {
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
             relaxation: Relaxation::new(choice.omega, choice.lag),
+            relaxation_choice: (choice.omega < 1.0 || choice.lag > 0.0).then_some(choice),
         })
     }
 
@@ -172,6 +175,11 @@ impl Interface {
     pub fn load(&self) -> Vec<[f64; 2]> {
         let k = if self.dt > 0.0 { 1.0 / self.dt } else { 0.0 };
         self.impulse.iter().map(|j| [j[0] * k, j[1] * k]).collect()
+    }
+
+    /// How the structure's contact impulse is relaxed; `None` where it is given at once.
+    pub fn relaxation(&self) -> Option<&relaxation::RelaxationChoice> {
+        self.relaxation_choice.as_ref()
     }
 
     /// The impulse owed to each interface node and not yet given (empty unless the reaction is relaxed), for a

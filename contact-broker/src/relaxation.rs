@@ -30,14 +30,16 @@
 //! choice). Fixed nodes pass their reaction on at once.
 
 use cosim_proto::scene::{ContactAlgorithm, FluidSolver, Scene};
+use serde::{Deserialize, Serialize};
 
 use crate::contact::ParticleParticleParams;
 
 /// Ω_c τ of the default lag: how many radians of the repulsive force's own oscillation it spans.
 pub const LAG_PERIODS: f64 = 5.0;
 
-/// How much of its owed contact impulse a structure node receives per coupling step, and why.
-#[derive(Clone, Debug, PartialEq)]
+/// How much of its owed contact impulse a structure node receives per coupling step, and why (`summary.json`
+/// `reaction_relaxation`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RelaxationChoice {
     /// The largest ω ∈ (0, 1] of a step.
     pub omega: f64,

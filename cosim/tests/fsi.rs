@@ -214,6 +214,14 @@ fn elastic_gate_isph_particle_particle_runs_to_its_end() {
     );
     let s = json(&out.join("summary.json"));
     assert_eq!(s["status"], "ok", "{s}");
+    // The relaxation the summary reports: at most 1/(1 + r) a step, r = 1000 × 0.14 / (1100 × 0.005) for the rubber.
+    let omega = s["reaction_relaxation"]["omega"]
+        .as_f64()
+        .expect("reaction_relaxation.omega");
+    assert!(
+        (omega - 1.0 / (1.0 + 1000.0 * 0.14 / (1100.0 * 0.005))).abs() < 1e-12,
+        "{s}"
+    );
     // The water column's potential energy, ρ g H² W / 2 (H = 0.14 m, W = 0.1 m): the coupled system may gain at most
     // 15 % of it (WCSPH with `particle_particle` gains 0.77 of it over this run: docs/VALIDATION.md).
     let budget = 1000.0 * 9.81 * 0.14 * 0.14 * 0.1 / 2.0;

@@ -299,6 +299,7 @@ component = "x"
                 timings: Timings::default(),
                 contact_stats: ContactStats::default(),
                 counts: Default::default(),
+                reaction_relaxation: None,
             },
         }
     }

@@ -67,6 +67,12 @@ impl ContactPass {
         self.interface.as_ref().and_then(|i| i.contacts())
     }
 
+    /// How the structure's contact impulse is relaxed ([`Interface::relaxation`]); `None` without an interface or
+    /// where it is given at once.
+    pub fn relaxation(&self) -> Option<&crate::relaxation::RelaxationChoice> {
+        self.interface.as_ref().and_then(|i| i.relaxation())
+    }
+
     /// The contact impulse owed to the structure's interface nodes ([`Interface::owed`]); empty without one.
     pub fn owed(&self) -> &[[f64; 2]] {
         self.interface.as_ref().map_or(&[], |i| i.owed())

@@ -140,6 +140,7 @@ fn drive(
         .map_or_else(Vec::new, |f| f.setup().interface_nodes());
     let mut outputs = Outputs::open(scene, nodes, &info.out, plan.restart.as_ref(), series)?;
     let mut contact = ContactPass::new(s, nodes)?;
+    summary.reaction_relaxation = contact.relaxation().cloned();
     let dt_fluid = nodes.sph.as_ref().map_or(f64::INFINITY, |n| n.setup().dt_stable);
     let mut clock = Clock::new(s, nodes.fem.is_some(), dt_fluid);
     let mut checkpoints = Schedule::new(plan.interval);

@@ -90,6 +90,11 @@ pub struct Summary {
     /// run that needed many of them is a run to look at). Empty for a node that could not say.
     #[serde(default)]
     pub counts: BTreeMap<String, BTreeMap<String, u64>>,
+    /// How the structure's contact impulse was relaxed (`contact.reaction_relaxation`; ISPH with
+    /// `particle_particle` by default): the largest ω of a step, the lag τ [s] that bounds it (0: none) and why;
+    /// `null` where every impulse was given at once.
+    #[serde(default)]
+    pub reaction_relaxation: Option<crate::relaxation::RelaxationChoice>,
 }
 
 impl Summary {
@@ -161,6 +166,7 @@ impl SummaryBuilder {
             timings: Timings::default(),
             contact_stats: ContactStats::default(),
             counts: BTreeMap::new(),
+            reaction_relaxation: None,
         })
     }
 
