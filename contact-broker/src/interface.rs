@@ -56,8 +56,6 @@ pub struct Interface {
     faces: bool,
     /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
     relaxation: Relaxation,
-    /// How `relaxation` was chosen; `None` where every impulse is given at once.
-    relaxation_choice: Option<relaxation::RelaxationChoice>,
 }
 
 impl Interface {
@@ -108,13 +106,9 @@ impl Interface {
             ContactChoice::ParticleParticle => Box::new(contact::ParticleParticle::new(force)),
             ContactChoice::None => Box::new(()),
         };
-        let choice = relaxation::choose(scene, &force);
-        if choice.omega < 1.0 || choice.lag > 0.0 {
-            tracing::info!(
-                "contact reaction relaxation ω = {:.4} ({})",
-                choice.omega,
-                choice.reason
-            );
+        let relaxation = Relaxation::new(relaxation::choose(scene, &force));
+        if let Some(c) = relaxation.choice() {
+            tracing::info!("contact reaction relaxation ω = {:.4} ({})", c.omega, c.reason);
         }
         Ok(Self {
             algorithm,
@@ -130,8 +124,7 @@ impl Interface {
             records: Vec::new(),
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
-            relaxation: Relaxation::new(choice.omega, choice.lag),
-            relaxation_choice: (choice.omega < 1.0 || choice.lag > 0.0).then_some(choice),
+            relaxation,
         })
     }
 
@@ -179,7 +172,7 @@ impl Interface {
 
     /// How the structure's contact impulse is relaxed; `None` where it is given at once.
     pub fn relaxation(&self) -> Option<&relaxation::RelaxationChoice> {
-        self.relaxation_choice.as_ref()
+        self.relaxation.choice()
     }
 
     /// The impulse owed to each interface node and not yet given (empty unless the reaction is relaxed), for a

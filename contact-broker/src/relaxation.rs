@@ -71,29 +71,32 @@ pub fn choose(scene: &Scene, force: &ParticleParticleParams) -> RelaxationChoice
         };
     };
     let depth = fluid.blocks.iter().map(|b| b.max[1] - b.min[1]).fold(0.0, f64::max);
-    let ratios = scene.solids.iter().map(|s| {
-        let (w, h) = (s.max[0] - s.min[0], s.max[1] - s.min[1]);
-        let r = fluid.density * w.max(h).max(depth) / (s.material.density * w.min(h));
-        (r, s.name.as_str())
-    });
-    match ratios.fold(None, |worst: Option<(f64, &str)>, (r, name)| match worst {
-        Some((rw, _)) if rw >= r => worst,
-        _ => Some((r, name)),
-    }) {
+    let worst = scene
+        .solids
+        .iter()
+        .map(|s| {
+            let (w, h) = (s.max[0] - s.min[0], s.max[1] - s.min[1]);
+            let r = fluid.density * w.max(h).max(depth) / (s.material.density * w.min(h));
+            (r, s.name.as_str())
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    match worst {
         Some((r, name)) if r.is_finite() && r > 0.0 => {
-            let omega_c = (force.strength * f64::from(force.p1 - force.p2)).sqrt() / force.r0;
+            let (omega, omega_c) = (
+                1.0 / (1.0 + r),
+                (force.strength * f64::from(force.p1 - force.p2)).sqrt() / force.r0,
+            );
             let lag = if omega_c.is_finite() && omega_c > 0.0 {
                 LAG_PERIODS / omega_c
             } else {
                 0.0
             };
             RelaxationChoice {
-                omega: 1.0 / (1.0 + r),
+                omega,
                 lag,
                 reason: format!(
-                    "ISPH with particle_particle: at most 1/(1 + r) = {:.4}, added-mass ratio r = {r:.3} of solid \
-                     `{name}`, and Δt/τ, lag τ = {LAG_PERIODS}/Ω_c = {lag:.3e} s",
-                    1.0 / (1.0 + r)
+                    "ISPH with particle_particle: at most 1/(1 + r) = {omega:.4}, added-mass ratio r = {r:.3} of solid \
+                     `{name}`, and Δt/τ, lag τ = {LAG_PERIODS}/Ω_c = {lag:.3e} s"
                 ),
             }
         }
@@ -105,38 +108,41 @@ pub fn choose(scene: &Scene, force: &ParticleParticleParams) -> RelaxationChoice
     }
 }
 
-/// The impulse each structure node is owed and not yet given (`particle_particle` with ω < 1).
+/// The impulse each structure node is owed and not yet given (`particle_particle` with ω < 1), and the choice of ω.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Relaxation {
-    omega: f64,
-    /// τ [s]: ω of a step of length Δt is at most Δt/τ; 0 for none.
-    lag: f64,
+    /// ω ≤ `choice.omega` a step and, where `choice.lag` τ > 0, ω ≤ Δt/τ.
+    choice: RelaxationChoice,
     /// Per interface node [N·s/m]; empty while nothing is owed, so ω = 1 costs nothing.
     owed: Vec<[f64; 2]>,
 }
 
 impl Relaxation {
-    /// Relaxation by at most `omega` ∈ (0, 1] per step and, where `lag` τ > 0, at most Δt/τ; `omega` 1 and `lag` 0
-    /// give every impulse at once.
-    pub fn new(omega: f64, lag: f64) -> Self {
+    /// Relaxation as `choice` says; ω 1 and lag 0 give every impulse at once.
+    pub fn new(choice: RelaxationChoice) -> Self {
         Self {
-            omega,
-            lag,
+            choice,
             owed: Vec::new(),
         }
     }
 
     /// Whether impulses are held back at all.
     pub fn active(&self) -> bool {
-        self.omega < 1.0 || self.lag > 0.0
+        self.choice.omega < 1.0 || self.choice.lag > 0.0
+    }
+
+    /// The choice of ω where impulses are held back; `None` where every one is given at once.
+    pub fn choice(&self) -> Option<&RelaxationChoice> {
+        self.active().then_some(&self.choice)
     }
 
     /// ω of a step of length `dt`.
     pub fn omega(&self, dt: f64) -> f64 {
-        if self.lag > 0.0 {
-            self.omega.min(dt / self.lag)
+        let RelaxationChoice { omega, lag, .. } = self.choice;
+        if lag > 0.0 {
+            omega.min(dt / lag)
         } else {
-            self.omega
+            omega
         }
     }
 

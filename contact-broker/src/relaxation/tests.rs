@@ -8,6 +8,15 @@ fn force() -> ParticleParticleParams {
     }
 }
 
+/// Relaxation by at most `omega` a step and, with `lag` > 0, at most Δt/`lag`.
+fn relaxation(omega: f64, lag: f64) -> Relaxation {
+    Relaxation::new(RelaxationChoice {
+        omega,
+        lag,
+        reason: String::new(),
+    })
+}
+
 /// The shipped gate with `overrides`.
 fn gate(overrides: &[&str]) -> Scene {
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/elastic_gate.toml");
@@ -45,7 +54,7 @@ fn omega_is_one_unless_isph_with_particle_particle_or_asked() {
 
 #[test]
 fn omega_one_gives_every_impulse_at_once() {
-    let mut relax = Relaxation::new(1.0, 0.0);
+    let mut relax = relaxation(1.0, 0.0);
     assert!(!relax.active());
     let mut j = vec![[1.0, -2.0], [3.0, 0.5]];
     let change = relax.give(&mut j, &[false, false], 1e-4);
@@ -58,7 +67,7 @@ fn omega_one_gives_every_impulse_at_once() {
 /// steps; a fixed node receives its reaction at once.
 #[test]
 fn impulse_given_plus_owed_is_the_impulse_of_the_passes() {
-    let mut relax = Relaxation::new(0.07, 0.0);
+    let mut relax = relaxation(0.07, 0.0);
     let (mut passes, mut given) = ([[0.0f64; 2]; 3], [[0.0f64; 2]; 3]);
     let mut scale = 0.0f64;
     for n in 0..500 {
@@ -98,7 +107,7 @@ fn impulse_given_plus_owed_is_the_impulse_of_the_passes() {
 fn relaxation_stabilises_the_added_mass_model_below_its_bound() {
     let (m, r) = (0.5, 14.0);
     let run = |omega: f64, steps: usize| {
-        let mut relax = Relaxation::new(omega, 0.0);
+        let mut relax = relaxation(omega, 0.0);
         let mut dv = 1.0f64;
         relax.restore(&[[(1.0 - omega) / omega * m * dv, 0.0]], 1).unwrap();
         for _ in 0..steps {
@@ -116,7 +125,7 @@ fn relaxation_stabilises_the_added_mass_model_below_its_bound() {
 
 #[test]
 fn restore_takes_nothing_or_one_impulse_per_node() {
-    let mut relax = Relaxation::new(0.5, 0.0);
+    let mut relax = relaxation(0.5, 0.0);
     relax.restore(&[], 3).unwrap();
     relax.restore(&[[1.0, 2.0]; 3], 3).unwrap();
     assert_eq!(relax.owed(), &[[1.0, 2.0]; 3]);
@@ -127,11 +136,11 @@ fn restore_takes_nothing_or_one_impulse_per_node() {
 /// With a lag τ, a step of length Δt gives at most Δt/τ of what is owed, and never more than the cap.
 #[test]
 fn a_lag_bounds_omega_by_the_step() {
-    let relax = Relaxation::new(0.1, 1e-3);
+    let relax = relaxation(0.1, 1e-3);
     assert!(relax.active());
     assert_eq!(relax.omega(2e-5), 2e-5 / 1e-3);
     assert_eq!(relax.omega(5e-4), 0.1);
-    let mut relax = Relaxation::new(1.0, 1e-3);
+    let mut relax = relaxation(1.0, 1e-3);
     let mut j = vec![[1.0, 0.0]];
     relax.give(&mut j, &[false], 1e-4);
     assert_eq!(j[0][0], 1e-4 / 1e-3);
