@@ -7,6 +7,7 @@ use cosim_proto::messages::{ContactFace, Correction, FemMesh, FemState, SphSetup
 use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
 use crate::contact::{self, ContactAlgorithm};
+use crate::contact_step;
 use crate::relaxation::{self, Relaxation};
 
 /// What one contact pass did, for `summary.json` `contact_stats` and the frames.
@@ -22,6 +23,8 @@ pub struct PassStats {
     pub linear_momentum_change: f64,
     /// |Δ Σ m x × v| / Σ m |x × Δv| at the corrected positions.
     pub angular_momentum_change: f64,
+    /// The longest next coupling step the contact force allows ([`crate::contact_step`]); `None` for no bound.
+    pub stable_dt: Option<f64>,
 }
 
 /// The corrections of one pass, per node.
@@ -56,6 +59,8 @@ pub struct Interface {
     faces: bool,
     /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
     relaxation: Relaxation,
+    /// Whether the contact's stiffness bounds the coupling step ([`contact_step::applies`]).
+    bounded_step: bool,
 }
 
 impl Interface {
@@ -125,6 +130,7 @@ impl Interface {
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
             relaxation,
+            bounded_step: contact_step::applies(scene),
         })
     }
 
@@ -238,6 +244,9 @@ impl Interface {
             let report = self.algorithm.correct(particles, nodes, &self.segments, dt)?;
             stats.contacts = report.contacts;
             stats.max_penetration = report.max_penetration;
+            if self.bounded_step {
+                stats.stable_dt = contact_step::stable_step(report.stiffness, self.relaxation.omega(dt));
+            }
             report.node_impulse
         };
         // Of the pass: the balance of the momentum it moved, before the structure's share is relaxed.

@@ -7,6 +7,7 @@
 
 pub mod checkpoint;
 pub mod contact;
+pub mod contact_step;
 pub mod coordinator;
 pub mod interface;
 pub mod link;

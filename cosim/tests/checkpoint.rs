@@ -187,19 +187,35 @@ fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
 
 #[test]
 fn isph_restart_is_byte_identical() {
-    isph_restart("checkpoint-isph", &[]);
+    gate_restart("checkpoint-isph", "isph", &[]);
 }
 
 /// ISPH with `particle_particle`: the contact impulse still owed to the gate's nodes at the checkpoint
 /// (`contact.reaction_relaxation`, `BrokerState::owed`) is saved and given on after the restart.
 #[test]
 fn isph_particle_particle_restart_is_byte_identical() {
-    isph_restart("checkpoint-isph-pp", &["--set", "contact.algorithm=particle_particle"]);
+    gate_restart(
+        "checkpoint-isph-pp",
+        "isph",
+        &["--set", "contact.algorithm=particle_particle"],
+    );
 }
 
-/// The coarse ISPH gate with `extra` arguments to 0.1 s, whole and continued from its 0.04 s checkpoint: the same
-/// probes byte for byte.
-fn isph_restart(name: &str, extra: &[&str]) {
+/// WCSPH with `particle_particle`: the bound the contact's stiffness has set on the coupling step
+/// (`BrokerState::dt_contact`) holds on after the restart.
+#[test]
+fn wcsph_particle_particle_restart_is_byte_identical() {
+    gate_restart(
+        "checkpoint-wcsph-pp",
+        "wcsph",
+        &["--set", "contact.algorithm=particle_particle"],
+    );
+}
+
+/// The coarse gate with fluid solver `solver` and `extra` arguments to 0.1 s, whole and continued from its 0.04 s
+/// checkpoint: the same probes byte for byte.
+fn gate_restart(name: &str, solver: &str, extra: &[&str]) {
+    let solver = format!("fluid.solver={solver}");
     let dir = scratch(name);
     let (whole, continued) = (dir.join("whole"), dir.join("continued"));
     let gate = scene("elastic_gate.toml");
@@ -210,7 +226,7 @@ fn isph_restart(name: &str, extra: &[&str]) {
             "--quiet",
             "--in-process",
             "--set",
-            "fluid.solver=isph",
+            &solver,
             "--set",
             "fluid.spacing=0.006",
             "--set",
@@ -245,7 +261,10 @@ fn isph_restart(name: &str, extra: &[&str]) {
     assert_eq!(times(&continued), [0.06, 0.09, 0.1]);
     let probes = |d: &Path| std::fs::read(d.join("probes.csv")).unwrap();
     assert!(probes(&whole).len() > 200, "samples written");
-    assert!(probes(&whole) == probes(&continued), "ISPH restart: probes.csv differs");
+    assert!(
+        probes(&whole) == probes(&continued),
+        "{solver} restart: probes.csv differs"
+    );
 }
 
 /// `run.frame_interval`: frames at every third output time of the coarse gate (0.015 s; probes every 0.005 s) and at

@@ -24,6 +24,8 @@ pub struct BrokerState {
     pub next_checkpoint: u64,
     /// The fluid's stable step last reported [s].
     pub dt_fluid: f64,
+    /// The longest step the contact allows from now on [s]; infinite where it sets no bound (`contact_step`).
+    pub dt_contact: f64,
     /// Contact corrections of the last step, still to be sent to the structure node.
     pub pending_fem: Vec<Correction>,
     /// … and to the fluid node.
@@ -81,6 +83,9 @@ impl BrokerState {
         // A step of 0 or less (or NaN, which `min` passes over) would never reach the end: the run would hang.
         ensure(self.dt_fluid > 0.0, || {
             format!("dt_fluid = {} is not a positive step", self.dt_fluid)
+        })?;
+        ensure(self.dt_contact > 0.0, || {
+            format!("dt_contact = {} is not a positive step", self.dt_contact)
         })?;
         let interval = scene.run.output_interval;
         // Every output time up to `t` is sampled, so the next one lies after it.
@@ -259,6 +264,7 @@ component = "x"
             next_output: 3,
             next_checkpoint: 2,
             dt_fluid: 1e-3,
+            dt_contact: f64::INFINITY,
             pending_fem: vec![Correction {
                 id: 5,
                 dx: [0.0, 1e-4],
@@ -300,6 +306,7 @@ component = "x"
                 contact_stats: ContactStats::default(),
                 counts: Default::default(),
                 reaction_relaxation: None,
+                contact_step_bound: None,
             },
         }
     }
@@ -350,6 +357,8 @@ component = "x"
         for dt in [0.0, -1e-3, f64::NAN] {
             let e = refused(|s| s.dt_fluid = dt);
             assert_eq!(e, format!("dt_fluid = {dt} is not a positive step"));
+            let e = refused(|s| s.dt_contact = dt);
+            assert_eq!(e, format!("dt_contact = {dt} is not a positive step"));
         }
         let e = refused(|s| s.next_output = 2);
         assert!(

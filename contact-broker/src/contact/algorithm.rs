@@ -45,6 +45,20 @@ pub struct PassReport {
     /// Impulse received by each node [N·s/m]: m Δv for a free node, the reaction passed to the support for a fixed
     /// one. Interface load = impulse / Δt.
     pub node_impulse: Vec<[f64; 2]>,
+    /// How stiff the pass's contact force was (particle–particle); zero for an algorithm that exerts none.
+    pub stiffness: Stiffness,
+}
+
+/// Bounds on the squared frequencies [1/s²] at which a contact force holds the bodies, for the coupling step that
+/// applies it explicitly (docs/CORRECTIONS.md "`particle_particle` heats the structure"): each is the largest row
+/// sum of M⁻¹K (Gershgorin) over the pass's pairs, K their radial stiffness −m ∂a/∂r.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stiffness {
+    /// Over the fluid particles: max_i Σ_j 2 k_ij / m_i.
+    pub particles: f64,
+    /// Over the free structure nodes: max_a Σ 2 N_a k_ij / m_a, the pair's reaction spread on the node with its
+    /// shape function N_a.
+    pub nodes: f64,
 }
 
 /// No contact (`[contact] algorithm = "none"`): nothing is corrected and no node receives an impulse.

@@ -61,7 +61,7 @@ mod pair;
 mod particle_element;
 mod particle_particle;
 
-pub use algorithm::{ContactAlgorithm, PassReport};
+pub use algorithm::{ContactAlgorithm, PassReport, Stiffness};
 pub use bodies::{Nodes, Particles, Segment};
 pub use error::ContactError;
 pub use face::nearest_face;

@@ -76,6 +76,7 @@ pub(super) fn save_if_due(
         next_output: clock.next_output,
         next_checkpoint: schedule.next,
         dt_fluid: clock.dt_fluid,
+        dt_contact: clock.dt_contact,
         pending_fem: contact.pending.fem.clone(),
         pending_sph: contact.pending.sph.clone(),
         roi: contact.roi,
@@ -124,7 +125,8 @@ pub(super) fn resume(
     summary: &mut Summary,
 ) -> anyhow::Result<()> {
     saved.check_nodes(summary.fem_nodes, summary.particles)?;
-    (clock.t, clock.step, clock.next_output, clock.dt_fluid) = (saved.t, saved.step, saved.next_output, saved.dt_fluid);
+    (clock.t, clock.step, clock.next_output) = (saved.t, saved.step, saved.next_output);
+    (clock.dt_fluid, clock.dt_contact) = (saved.dt_fluid, saved.dt_contact);
     // From the time, not the saved index: the restart may ask for another interval.
     schedule.next = schedule
         .interval

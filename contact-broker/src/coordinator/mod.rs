@@ -171,6 +171,8 @@ fn drive(
             clock.advance(&step, &round, summary);
             // §3 step 4: contact on the states just reported; the corrections go out with the next command.
             contact.pass(&round, &step, clock.step, clock.t, summary)?;
+            clock.contact_bound(contact.last.stable_dt);
+            summary.contact_step_bound = clock.dt_contact.is_finite().then_some(clock.dt_contact);
             // §5: probes and frames at an output time.
             if step.lands {
                 outputs.sample(

@@ -19,6 +19,9 @@ pub(super) struct Clock {
     pub next_output: u64,
     /// The fluid's stable step last reported [s] (infinite without a fluid).
     pub dt_fluid: f64,
+    /// The longest step the contact passes so far allow [s] (infinite where none set a bound:
+    /// [`crate::contact_step`]).
+    pub dt_contact: f64,
     interval: f64,
     end: f64,
     max_dt: f64,
@@ -46,6 +49,7 @@ impl Clock {
             step: 0,
             next_output: 1,
             dt_fluid,
+            dt_contact: f64::INFINITY,
             interval: scene.run.output_interval,
             end: scene.run.end_time,
             max_dt: scene.coupling.max_dt,
@@ -63,12 +67,13 @@ impl Clock {
         self.t < self.end
     }
 
-    /// Fix the next coupling step: the fluid's stable step, capped by the user and the next output time. Without
-    /// a structure there is nothing to couple: the fluid node sub-cycles at its own stable step.
+    /// Fix the next coupling step: the fluid's stable step and the contact's, capped by the user and the next
+    /// output time. Without a structure there is nothing to couple: the fluid node sub-cycles at its own stable
+    /// step.
     pub fn next_step(&mut self) -> Step {
         let target = (self.next_output as f64 * self.interval).min(self.end);
         let cap = if self.structure {
-            self.max_dt.min(self.dt_fluid)
+            self.max_dt.min(self.dt_fluid).min(self.dt_contact)
         } else {
             self.max_dt
         };
@@ -79,6 +84,16 @@ impl Clock {
         }
         self.step += 1;
         Step { dt, lands, target, cap }
+    }
+
+    /// A contact pass allows the next step to be at most `dt` long (`None`: no bound); the bound holds for the rest
+    /// of the run.
+    pub fn contact_bound(&mut self, dt: Option<f64>) {
+        // Never longer again: a step that follows the contact's stiffness up and down pumps energy into it
+        // (contact_step.rs).
+        if let Some(dt) = dt {
+            self.dt_contact = self.dt_contact.min(dt);
+        }
     }
 
     /// The nodes answered `step`: count their sub-steps, take the fluid's new stable step, and move on to the end

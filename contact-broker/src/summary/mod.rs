@@ -95,6 +95,10 @@ pub struct Summary {
     /// `null` where every impulse was given at once.
     #[serde(default)]
     pub reaction_relaxation: Option<crate::relaxation::RelaxationChoice>,
+    /// The longest coupling step the contact force's stiffness allowed [s] (WCSPH with `particle_particle`:
+    /// `contact_step.rs`), `null` where it set no bound.
+    #[serde(default)]
+    pub contact_step_bound: Option<f64>,
 }
 
 impl Summary {
@@ -167,6 +171,7 @@ impl SummaryBuilder {
             contact_stats: ContactStats::default(),
             counts: BTreeMap::new(),
             reaction_relaxation: None,
+            contact_step_bound: None,
         })
     }
 

@@ -34,7 +34,7 @@ pub use params::ContactParams;
 pub use report::ContactReport;
 pub use workspace::ParticleElementWorkspace;
 
-use crate::contact::algorithm::{ContactAlgorithm, PassReport};
+use crate::contact::algorithm::{ContactAlgorithm, PassReport, Stiffness};
 use crate::contact::bodies::{validate, Nodes, Particles, Segment};
 use crate::contact::error::ContactError;
 use pairs::Out;
@@ -176,6 +176,7 @@ impl ContactAlgorithm for ParticleElement {
             contacts: report.contacts,
             max_penetration: report.max_penetration,
             node_impulse: report.node_impulse,
+            stiffness: Stiffness::default(),
         })
     }
 
