@@ -92,6 +92,13 @@ impl Clock {
         // Never longer again: a step that follows the contact's stiffness up and down pumps energy into it
         // (contact_step.rs).
         if let Some(dt) = dt {
+            if self.dt_contact.is_infinite() {
+                tracing::info!(
+                    "the contact force's stiffness bounds the coupling step from t = {:.6} s: {dt:.3e} s (and shorter where \
+                     it asks; summary.json contact_step_bound)",
+                    self.t
+                );
+            }
             self.dt_contact = self.dt_contact.min(dt);
         }
     }
