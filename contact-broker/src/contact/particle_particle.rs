@@ -354,6 +354,17 @@ impl ContactAlgorithm for ParticleParticle {
 mod tests {
     use super::*;
 
+    /// D = 2, r0 = 0.1, p1 = 12, p2 = 4, and no points along a segment shorter than 20.
+    fn one_pair() -> ParticleParticleParams {
+        ParticleParticleParams {
+            spacing: 20.0,
+            strength: 2.0,
+            r0: 0.1,
+            p1: 12,
+            p2: 4,
+        }
+    }
+
     #[test]
     fn single_point_force_matches_monaghan() {
         // One node (a segment's end far away): particle at distance 0.5 r0 straight above node 0.
@@ -361,13 +372,7 @@ mod tests {
         let mut pv = [[0.0, 0.0]];
         let mut nx = [[0.0, 0.0], [10.0, 0.0]];
         let mut nv = [[0.0; 2]; 2];
-        let params = ParticleParticleParams {
-            spacing: 20.0,
-            strength: 2.0,
-            r0: 0.1,
-            p1: 12,
-            p2: 4,
-        };
+        let params = one_pair();
         let p = Particles {
             x: &mut px,
             v: &mut pv,
@@ -393,13 +398,7 @@ mod tests {
     /// and 2 m_p k / m_a for a free node, k at the turning point.
     #[test]
     fn stiffness_potential_and_turning_point_agree_with_the_force() {
-        let params = ParticleParticleParams {
-            spacing: 20.0,
-            strength: 2.0,
-            r0: 0.1,
-            p1: 12,
-            p2: 4,
-        };
+        let params = one_pair();
         let accel = |r: f64| {
             let q = 0.1 / r;
             2.0 * (q.powi(12) - q.powi(4)) / r
