@@ -23,16 +23,18 @@
 //! assumes. An ISPH particle is held by the pressure solve within its step, and its contact reaction is relaxed
 //! instead (`relaxation.rs`); the free particle's bound would take from ISPH the long step it exists for.
 
-use cosim_proto::scene::{FluidSolver, Scene};
+use cosim_proto::scene::{ContactAlgorithm, FluidSolver, Scene};
 
 use crate::contact::Stiffness;
 
 /// Ω_max Δt of the longest coupling step a stiff contact allows.
 pub const COURANT: f64 = 0.7;
 
-/// Whether `scene`'s coupling steps are bounded by the contact force's stiffness: with a WCSPH fluid.
+/// Whether `scene`'s coupling steps are bounded by the contact force's stiffness: `particle_particle` with a WCSPH
+/// fluid (the other algorithms exert no force: [`Stiffness`] zero).
 pub fn applies(scene: &Scene) -> bool {
-    scene.fluid.as_ref().is_some_and(|f| f.solver == FluidSolver::Wcsph)
+    scene.contact.algorithm == ContactAlgorithm::ParticleParticle
+        && scene.fluid.as_ref().is_some_and(|f| f.solver == FluidSolver::Wcsph)
 }
 
 /// The longest next coupling step for a pass of stiffness `stiffness` whose nodes receive the share `omega` of their

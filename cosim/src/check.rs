@@ -44,6 +44,8 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         .min(s.run.output_interval)
         .min(if coupled { dt_fluid } else { f64::INFINITY });
     let steps = (s.run.end_time / dt).ceil() as u64;
+    // WCSPH + particle_particle: the contact shortens the coupling step as the run goes (contact_step.rs).
+    let contact_bound = coupled && contact_broker::contact_step::applies(s);
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
     let samples = s.run.sample_count();
     let frames = s.run.frame_count();
@@ -60,6 +62,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "sph_steps_estimate": fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil() as u64),
             "coupling_dt": dt,
             "coupling_steps": steps,
+            "coupling_dt_bounded_by_contact": contact_bound,
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
             "frames": frames,
@@ -149,6 +152,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "  steps: coupling dt {dt} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
         ),
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
+    }
+    if contact_bound {
+        println!(
+            "  steps: particle_particle with WCSPH shortens the coupling step to what its stiff force needs as the run \
+             goes (2-3 times the steps above on the shipped scenes; summary.json contact_step_bound)"
+        );
     }
     println!("  totals: {nodes} FE nodes, {elements} elements, {particles} particles (coupling steps are estimated from the initial stable step)");
     // A node the scene does not start has no share.

@@ -216,6 +216,28 @@ fn check_prints_what_would_run() {
     assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
 }
 
+/// `cosim check` says where the coupling step will be shorter than its estimate: WCSPH with `particle_particle`,
+/// whose stiff force bounds it as the run goes (contact-broker/src/contact_step.rs), not `particle_element` nor ISPH.
+#[test]
+fn check_says_when_the_contact_bounds_the_step() {
+    let gate = root().join("scenes/elastic_gate.toml");
+    let bounded = |extra: &[&str]| {
+        let mut args = vec!["check", gate.to_str().unwrap(), "--json"];
+        for set in extra {
+            args.extend_from_slice(&["--set", set]);
+        }
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["coupling_dt_bounded_by_contact"].clone()
+    };
+    assert_eq!(bounded(&[]), false);
+    assert_eq!(bounded(&["contact.algorithm=particle_particle"]), true);
+    assert_eq!(
+        bounded(&["contact.algorithm=particle_particle", "fluid.solver=isph"]),
+        false
+    );
+}
+
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
 /// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]
