@@ -99,6 +99,17 @@ impl Clock {
                     self.t
                 );
             }
+            // Once, where it makes the run ten times longer than the fluid alone would: say so while it runs.
+            let slow = 0.1 * self.dt_fluid.min(self.max_dt);
+            if dt < slow && self.dt_contact >= slow {
+                tracing::warn!(
+                    "the contact force's stiffness shortens the coupling step to {dt:.3e} s at t = {:.6} s, under a tenth \
+                     of the {:.3e} s the fluid and coupling.max_dt allow: the rest of the run takes over ten times the steps \
+                     (particle_particle with WCSPH; particle_element sets no such bound)",
+                    self.t,
+                    self.dt_fluid.min(self.max_dt)
+                );
+            }
             self.dt_contact = self.dt_contact.min(dt);
         }
     }
