@@ -59,8 +59,6 @@ pub struct Interface {
     faces: bool,
     /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
     relaxation: Relaxation,
-    /// Whether the contact's stiffness bounds the coupling step ([`contact_step::applies`]).
-    bounded_step: bool,
 }
 
 impl Interface {
@@ -108,7 +106,9 @@ impl Interface {
             ContactChoice::ParticleElement => {
                 Box::new(contact::ParticleElement::new(element_params(scene, dx, thickness)))
             }
-            ContactChoice::ParticleParticle => Box::new(contact::ParticleParticle::new(force)),
+            ContactChoice::ParticleParticle => {
+                Box::new(contact::ParticleParticle::new(force, contact_step::applies(scene)))
+            }
             ContactChoice::None => Box::new(()),
         };
         let relaxation = Relaxation::new(relaxation::choose(scene, &force));
@@ -130,7 +130,6 @@ impl Interface {
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
             relaxation,
-            bounded_step: contact_step::applies(scene),
         })
     }
 
@@ -244,9 +243,8 @@ impl Interface {
             let report = self.algorithm.correct(particles, nodes, &self.segments, dt)?;
             stats.contacts = report.contacts;
             stats.max_penetration = report.max_penetration;
-            if self.bounded_step {
-                stats.stable_dt = contact_step::stable_step(report.stiffness, self.relaxation.omega(dt));
-            }
+            // Zero, so no bound, unless the algorithm measured it (contact_step::applies).
+            stats.stable_dt = contact_step::stable_step(report.stiffness, self.relaxation.omega(dt));
             report.node_impulse
         };
         // Of the pass: the balance of the momentum it moved, before the structure's share is relaxed.

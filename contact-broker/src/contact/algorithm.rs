@@ -153,7 +153,7 @@ mod tests {
         let (p0, n0, r0): (_, _, ParticleParticleReport) =
             run(|p, n, s| particle_particle(p, n, s, &params, 0.01).unwrap());
         assert!(r0.contacts > 0, "{r0:?}");
-        let mut pp: Box<dyn ContactAlgorithm> = Box::new(ParticleParticle::new(params));
+        let mut pp: Box<dyn ContactAlgorithm> = Box::new(ParticleParticle::new(params, true));
         for _ in 0..2 {
             let (p, n, r) = run(|p, n, s| pp.correct(p, n, s, 0.01).unwrap());
             assert_eq!((p, n), (p0.clone(), n0.clone()));

@@ -111,7 +111,7 @@ pub struct ParticleParticleReport {
     /// Impulse received by each node [N·s/m]: m Δv for a free node, the reaction passed to the support for a fixed
     /// one. Interface load = impulse / Δt.
     pub node_impulse: Vec<[f64; 2]>,
-    /// The force's stiffness over the pairs, as the particles and the free nodes feel it.
+    /// The force's stiffness over the pairs, as the particles and the free nodes feel it (zero unless asked for).
     pub stiffness: Stiffness,
 }
 
@@ -141,7 +141,8 @@ pub struct ParticleParticleWorkspace {
 }
 
 /// Applies Δt times the repulsive acceleration to the particles' velocities and the reactions to the nodes (free
-/// nodes' velocities change by impulse/m; fixed ones only report it). Positions are not changed.
+/// nodes' velocities change by impulse/m; fixed ones only report it). Positions are not changed. Reports the force's
+/// [`Stiffness`] too.
 pub fn particle_particle(
     particles: Particles<'_>,
     nodes: Nodes<'_>,
@@ -156,10 +157,12 @@ pub fn particle_particle(
         segments,
         params,
         dt,
+        true,
     )
 }
 
-/// [`particle_particle`] reusing the scratch arrays of `ws`.
+/// [`particle_particle`] reusing the scratch arrays of `ws`; the [`Stiffness`] (a turning point per pair) only where
+/// `stiffness` asks for it.
 pub fn particle_particle_with(
     ws: &mut ParticleParticleWorkspace,
     particles: Particles<'_>,
@@ -167,6 +170,7 @@ pub fn particle_particle_with(
     segments: &[Segment],
     params: &ParticleParticleParams,
     dt: f64,
+    stiffness: bool,
 ) -> Result<ParticleParticleReport, ContactError> {
     params.validate()?;
     param("dt", dt, dt >= 0.0, "non-negative and finite")?;
@@ -234,7 +238,7 @@ pub fn particle_particle_with(
         let xs = particles.x[s];
         let mut acc = [0.0; 2];
         let mut any = false;
-        let mut stiffness = 0.0;
+        let mut row = 0.0;
         let m_dt = particles.m[s] * dt;
         for &i in grid.query(xs) {
             let p = points[i as usize];
@@ -252,8 +256,12 @@ pub fn particle_particle_with(
             acc = [acc[0] + a[0], acc[1] + a[1]];
             // How stiff the pair will be where it turns: entered twice, since the particle's row sum of M⁻¹K is
             // Σ k/m (1 + N_a + N_b).
-            let k = params.stiffness(params.turning_point(dist, closing_energy(&particles, &nodes, s, &p, r, dist)));
-            stiffness += 2.0 * k;
+            let k = if stiffness {
+                params.stiffness(params.turning_point(dist, closing_energy(&particles, &nodes, s, &p, r, dist)))
+            } else {
+                0.0
+            };
+            row += 2.0 * k;
             any = true;
             report.contacts += 1;
             report.max_penetration = report.max_penetration.max(r0 - dist);
@@ -265,17 +273,17 @@ pub fn particle_particle_with(
                 node_stiffness[node] += 2.0 * particles.m[s] * k * nk;
             }
         }
-        report.stiffness.particles = report.stiffness.particles.max(stiffness);
+        report.stiffness.particles = report.stiffness.particles.max(row);
         if any {
             let v = &mut particles.v[s];
             *v = [v[0] + dt * acc[0], v[1] + dt * acc[1]];
             report.particles_corrected += 1;
         }
     }
-    for (k, stiffness) in node_stiffness.iter().enumerate() {
+    for (k, row) in node_stiffness.iter().enumerate() {
         let imp = report.node_impulse[k];
         if !nodes.fixed[k] {
-            report.stiffness.nodes = report.stiffness.nodes.max(stiffness / nodes.m[k]);
+            report.stiffness.nodes = report.stiffness.nodes.max(row / nodes.m[k]);
         }
         if !nodes.fixed[k] && (imp[0] != 0.0 || imp[1] != 0.0) {
             let v = &mut nodes.v[k];
@@ -318,14 +326,17 @@ fn closing_energy(
 pub struct ParticleParticle {
     /// The parameters of every pass.
     pub params: ParticleParticleParams,
+    /// Whether each pass reports the force's [`Stiffness`] (for a coupling step bounded by it).
+    stiffness: bool,
     workspace: ParticleParticleWorkspace,
 }
 
 impl ParticleParticle {
-    /// The algorithm with `params` and an empty workspace.
-    pub fn new(params: ParticleParticleParams) -> Self {
+    /// The algorithm with `params` and an empty workspace; its passes report the [`Stiffness`] where `stiffness`.
+    pub fn new(params: ParticleParticleParams, stiffness: bool) -> Self {
         ParticleParticle {
             params,
+            stiffness,
             workspace: ParticleParticleWorkspace::default(),
         }
     }
@@ -340,7 +351,8 @@ impl ContactAlgorithm for ParticleParticle {
         segments: &[Segment],
         dt: f64,
     ) -> Result<PassReport, ContactError> {
-        let report = particle_particle_with(&mut self.workspace, particles, nodes, segments, &self.params, dt)?;
+        let ws = &mut self.workspace;
+        let report = particle_particle_with(ws, particles, nodes, segments, &self.params, dt, self.stiffness)?;
         Ok(PassReport {
             contacts: report.contacts,
             max_penetration: report.max_penetration,
