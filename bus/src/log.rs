@@ -3,13 +3,23 @@
 //! stderr fails, and so does `tracing-subscriber` by default, reporting the failure through `eprintln!`): a full
 //! disk must end the run with its summary, not kill the process that writes it.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 
-/// Log `tracing` events on stderr (level from `RUST_LOG`, default `warn`), dropping those that cannot be written.
+/// What a node's log keeps without `RUST_LOG`: warnings from everything, and the run's own events (`info`) from
+/// our crates — a checkpoint written, the contact's reaction relaxation or step bound chosen, a pause — which
+/// happen a few times a run and say in the log file what the run did; zenoh's own `info` lines stay out.
+pub const DEFAULT_FILTER: &str = "warn,contact_broker=info,sph_node=info,fem_node=info,cosim_bus=info";
+
+/// Log `tracing` events on stderr (level from `RUST_LOG`, default [`DEFAULT_FILTER`]), dropping those that cannot
+/// be written.
 pub fn init() {
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "warn".into()))
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| DEFAULT_FILTER.into()),
+        )
         .with_writer(std::io::stderr)
+        // A node's stderr is its log file: colour codes only where a person reads it in a terminal.
+        .with_ansi(std::io::stderr().is_terminal())
         .log_internal_errors(false)
         .init();
 }

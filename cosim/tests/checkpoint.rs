@@ -82,6 +82,15 @@ fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
     run_ok(&[&args[..], &["--out", &reference_s, "--run-id", &run_id("ck-ref")]].concat());
     let written = checkpoints(&reference);
     assert_eq!(written.len(), 4, "checkpoints at 0.05, 0.1, 0.15, 0.2 s: {written:?}");
+    // The broker's log says where each went (its `info` lines are kept without RUST_LOG: bus::log::DEFAULT_FILTER).
+    let log = std::fs::read_to_string(reference.join("logs/contact-broker.log")).unwrap();
+    for (_, dir) in &written {
+        assert!(
+            log.contains(&format!("checkpoint {}: ", dir.display())),
+            "{} not in the broker's log:\n{log}",
+            dir.display()
+        );
+    }
     let manifest = json(&written[0].1.join("checkpoint.json"));
     assert_eq!(manifest["t"].as_f64(), Some(0.05));
     assert_eq!(manifest["protocol_version"].as_u64(), Some(u64::from(PROTOCOL_VERSION)));
