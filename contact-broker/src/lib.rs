@@ -1,6 +1,6 @@
 //! Contact algorithms and the step coordinator of the FEM–SPH co-simulation.
 //!
-//! `coordinator`, `interface`, `relaxation`, `probes`, `summary` and `output` are pure (files, no messaging);
+//! `coordinator`, `interface`, `relaxation`, `probes`, `energy_balance`, `summary` and `output` are pure (files, no messaging);
 //! `setup` is the set-up of a run that `cosim run` and the `contact-broker` binary share; `transport` is the zenoh
 //! adapter used by the binary.
 #![warn(missing_docs)]
@@ -9,6 +9,7 @@ pub mod checkpoint;
 pub mod contact;
 pub mod contact_step;
 pub mod coordinator;
+pub mod energy_balance;
 pub mod interface;
 pub mod link;
 pub mod output;

@@ -229,6 +229,25 @@ impl Probes {
             .collect()
     }
 
+    /// The mechanical energy of the snapshots, as an `energy` probe of the whole run counts it (`part = "total"`,
+    /// `of = "all"`): the fluid's kinetic energy and its gravitational energy relative to its first positions, plus
+    /// the structure's kinetic, strain and gravitational energy [J/m]. Call after [`Probes::sample`] of the same
+    /// output time (which takes the fluid's first positions).
+    pub fn mechanical_energy(
+        &self,
+        fem: Option<(&FemMesh, &FemSnapshot)>,
+        sph: Option<(&SphSetup, &SphSnapshot)>,
+    ) -> f64 {
+        let structure = fem.map_or(0.0, |(_, snap)| structure_energy(snap, EnergyPart::Total, None));
+        let fluid = sph.map_or(0.0, |(_, snap)| self.fluid_energy(snap, EnergyPart::Total));
+        structure + fluid
+    }
+
+    /// Gravity, as the scene gives it.
+    pub fn gravity(&self) -> [f64; 2] {
+        self.gravity
+    }
+
     fn fluid_energy(&self, snap: &SphSnapshot, part: EnergyPart) -> f64 {
         let kinetic = || {
             snap.m

@@ -164,6 +164,10 @@ fn a_killed_run_continues_from_its_last_checkpoint_byte_for_byte() {
     let summary = json(&crashed.join("summary.json"));
     assert_eq!(summary["status"], "ok");
     assert_eq!(summary["steps"].as_u64(), Some(written[3].0));
+    // The energy balance goes on from the checkpoint's: the same as the uninterrupted run's, to the bit.
+    let whole = json(&reference.join("summary.json"));
+    assert!(whole["energy_growth"]["budget"].as_f64() > Some(0.0), "{whole}");
+    assert_eq!(summary["energy_growth"], whole["energy_growth"]);
     assert_eq!(
         checkpoints(&crashed).len(),
         4,

@@ -87,6 +87,13 @@ impl BrokerState {
         ensure(self.dt_contact > 0.0, || {
             format!("dt_contact = {} is not a positive step", self.dt_contact)
         })?;
+        if let Some(g) = &s.energy_growth {
+            // A budget that is not positive would divide every later gain by zero or turn its sign.
+            ensure(
+                g.budget > 0.0 && g.budget.is_finite() && finite(&[g.initial, g.largest, g.at]) && g.largest >= 0.0,
+                || format!("summary.energy_growth = {g:?} is not a balance (budget > 0, gain ≥ 0, all finite)"),
+            )?;
+        }
         let interval = scene.run.output_interval;
         // Every output time up to `t` is sampled, so the next one lies after it.
         ensure(
@@ -307,6 +314,7 @@ component = "x"
                 counts: Default::default(),
                 reaction_relaxation: None,
                 contact_step_bound: None,
+                energy_growth: None,
             },
         }
     }
@@ -375,5 +383,33 @@ component = "x"
         assert_eq!(e, "owed[0] = [0.0, NaN] is not finite");
         let e = refused(|s| s.owed = vec![[0.0; 2]; 7]);
         assert_eq!(e, "owed holds 7 nodes, the structure has 6");
+    }
+
+    #[test]
+    fn an_energy_balance_without_a_budget_is_refused() {
+        let growth = |budget: f64, largest: f64| {
+            refused(|s| {
+                s.summary.energy_growth = Some(crate::energy_balance::EnergyGrowth {
+                    largest,
+                    at: 0.1,
+                    budget,
+                    initial: -1.0,
+                })
+            })
+        };
+        for (budget, largest) in [
+            (0.0, 0.1),
+            (-2.0, 0.1),
+            (f64::NAN, 0.1),
+            (2.0, f64::INFINITY),
+            (2.0, -0.5),
+        ] {
+            let e = growth(budget, largest);
+            assert!(e.starts_with("summary.energy_growth = "), "{e}");
+            assert!(
+                e.ends_with("is not a balance (budget > 0, gain ≥ 0, all finite)"),
+                "{e}"
+            );
+        }
     }
 }

@@ -7,12 +7,13 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use cosim_proto::messages::{FemMesh, SphSnapshot};
+use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
 use cosim_proto::scene::LoadedScene;
 
 use super::exchange::Round;
 use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
+use crate::energy_balance::{releasable, EnergyGrowth};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
@@ -110,6 +111,7 @@ impl<'s> Outputs<'s> {
         self.csv.push(t, &values)?;
         self.push_series(t, &values);
         let index = summary.samples as usize;
+        energy_balance(&self.probes, t, index, fem, sph, summary);
         summary.samples += 1;
         if self.run.is_frame(index as u64, last) {
             if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
@@ -140,6 +142,34 @@ impl<'s> Outputs<'s> {
     fn push_series(&mut self, t: f64, values: &[f64]) {
         for (line, v) in self.series.iter_mut().zip(values) {
             line.push((t, *v));
+        }
+    }
+}
+
+/// The run's energy balance at output time `t`, the `index`-th (`energy_balance.rs`): started at the first,
+/// taken at the others; the first output time whose gain passes [`crate::energy_balance::WARN_GROWTH`] of the budget is logged.
+fn energy_balance(
+    probes: &Probes,
+    t: f64,
+    index: usize,
+    fem: Option<(&FemMesh, &FemSnapshot)>,
+    sph: Option<(&SphSetup, &SphSnapshot)>,
+    summary: &mut Summary,
+) {
+    let energy = probes.mechanical_energy(fem, sph);
+    if index == 0 {
+        let budget = sph.map_or(0.0, |(_, s)| releasable(&s.m, &s.x, probes.gravity()));
+        summary.energy_growth = EnergyGrowth::start(t, energy, budget);
+    } else if let Some(growth) = summary.energy_growth.as_mut() {
+        if growth.observe(t, energy) {
+            tracing::warn!(
+                "by t = {t} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m the \
+                 water can release: nothing in the scene supplies it, so the scheme made it (an unstable coupling, or a \
+                 step too long for it); what follows may be unphysical (summary.json energy_growth)",
+                growth.largest * growth.budget,
+                100.0 * growth.largest,
+                growth.budget
+            );
         }
     }
 }

@@ -99,6 +99,10 @@ pub struct Summary {
     /// `contact_step.rs`), `null` where it set no bound.
     #[serde(default)]
     pub contact_step_bound: Option<f64>,
+    /// The largest mechanical energy the fluid and the structure together gained over t = 0, at the output times,
+    /// against the energy the water can release (`energy_balance.rs`); `null` without a fluid under gravity.
+    #[serde(default)]
+    pub energy_growth: Option<crate::energy_balance::EnergyGrowth>,
 }
 
 impl Summary {
@@ -113,7 +117,7 @@ impl Summary {
     }
 
     /// Carry on the counts of `saved`, the summary of the run a checkpoint was taken in: its steps, simulated time,
-    /// frames, samples, timings and contact statistics.
+    /// frames, samples, timings, contact statistics and energy balance.
     pub fn continue_from(&mut self, saved: &Summary) {
         self.steps = saved.steps;
         self.fem_substeps = saved.fem_substeps;
@@ -123,6 +127,7 @@ impl Summary {
         self.samples = saved.samples;
         self.timings = saved.timings.clone();
         self.contact_stats = saved.contact_stats.clone();
+        self.energy_growth = saved.energy_growth.clone();
     }
 
     /// End the run after `wall_seconds`: `ok`, saying how far it got, or `failure`'s status and message.
@@ -172,6 +177,7 @@ impl SummaryBuilder {
             counts: BTreeMap::new(),
             reaction_relaxation: None,
             contact_step_bound: None,
+            energy_growth: None,
         })
     }
 

@@ -1,0 +1,122 @@
+//! The run's energy balance (`summary.json` `energy_growth`): how much mechanical energy the fluid and the
+//! structure together hold over what they held at t = 0, sampled at every output time, against the potential
+//! energy the water can release.
+//!
+//! Nothing in a scene drives the water or the structure (no moving wall, no inflow, no applied load besides
+//! gravity), so the fluid's kinetic and gravitational energy plus the structure's kinetic, strain and
+//! gravitational energy can only fall: the viscosities, the contact's inelastic velocity correction (Long et al.
+//! 2016, Eq. (12)) take energy out of it, and the WCSPH fluid's elastic energy, which it does not count, only
+//! borrows from it. A gain is energy the numerical scheme
+//! made: the symptom of an unstable coupling, or of a step too long for it, often long before anything blows up
+//! (the coupled ISPH gate at `coupling.max_dt = 1e-2` ends `ok` having gained its whole budget, docs/CORRECTIONS.md
+//! "The structure's own face velocity, sent by the broker"). A run whose gain passes [`WARN_GROWTH`] of the budget
+//! says so once in its log while it runs; every run with a fluid under gravity reports its largest gain.
+
+use serde::{Deserialize, Serialize};
+
+/// A gain beyond this fraction of the budget is a warning (once a run). As shipped the scenes gain at most 0.0016
+/// with WCSPH, 0.032 with ISPH and 0.079 with ISPH + `particle_particle` (the gate; docs/VALIDATION.md, 2026-11-29
+/// twelfth); the stress tests bound the fluid's own gain by 0.05.
+pub const WARN_GROWTH: f64 = 0.1;
+
+/// The largest energy gain of a run so far (`summary.json` `energy_growth`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnergyGrowth {
+    /// The largest gain E(t) − E(0) over the output times so far, as a fraction of [`EnergyGrowth::budget`] (0 at
+    /// the start: t = 0 counts).
+    pub largest: f64,
+    /// The output time of the largest gain [s].
+    pub at: f64,
+    /// The potential energy the water can release [J/m]: Σ m |g| (h − h_min) over the fluid at t = 0, h the height
+    /// against gravity (ρ g W H²/2 less half a spacing's worth for a block W × H on a floor).
+    pub budget: f64,
+    /// E(0) [J/m]: the fluid's kinetic energy and its gravitational energy relative to its first positions, plus
+    /// the structure's kinetic, strain and gravitational energy, as the `energy` probes count them.
+    pub initial: f64,
+}
+
+impl EnergyGrowth {
+    /// The balance of a run whose first output time holds `energy`, with `budget` ([`releasable`]); `None` where
+    /// there is no budget to measure a gain against (no fluid, no gravity).
+    pub fn start(t: f64, energy: f64, budget: f64) -> Option<Self> {
+        (budget > 0.0 && budget.is_finite() && energy.is_finite()).then_some(Self {
+            largest: 0.0,
+            at: t,
+            budget,
+            initial: energy,
+        })
+    }
+
+    /// Take the energy of output time `t`; true at the first output time whose gain passes [`WARN_GROWTH`]. A
+    /// non-finite energy (a state blowing up, which the nodes refuse) is skipped.
+    pub fn observe(&mut self, t: f64, energy: f64) -> bool {
+        let gain = (energy - self.initial) / self.budget;
+        if !(energy.is_finite() && gain > self.largest) {
+            return false;
+        }
+        let crossed = self.largest <= WARN_GROWTH && gain > WARN_GROWTH;
+        self.largest = gain;
+        self.at = t;
+        crossed
+    }
+}
+
+/// The potential energy particles of masses `m` at `x` release under `gravity` falling to the height of the lowest
+/// of them: Σ m |g| (h − h_min), h = −g·x/|g| [J/m]. Zero without gravity or particles.
+pub fn releasable(m: &[f64], x: &[[f64; 2]], gravity: [f64; 2]) -> f64 {
+    let g = gravity[0].hypot(gravity[1]);
+    let down = g.is_finite() && g > 0.0;
+    if !down || x.is_empty() {
+        return 0.0;
+    }
+    let height = |x: &[f64; 2]| -(gravity[0] * x[0] + gravity[1] * x[1]) / g;
+    let lowest = x.iter().map(height).fold(f64::INFINITY, f64::min);
+    m.iter().zip(x).map(|(m, x)| m * g * (height(x) - lowest)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_budget_of_a_column_is_its_weight_times_its_height_over_two() {
+        // A column of 10 particles of 1 kg, 0.1 m apart, the lowest at y = 0.05: Σ m g (y − 0.05) = g · 0.1 · 45.
+        let x: Vec<[f64; 2]> = (0..10).map(|k| [0.3, 0.05 + 0.1 * k as f64]).collect();
+        let m = vec![1.0; 10];
+        let b = releasable(&m, &x, [0.0, -9.81]);
+        assert!((b - 9.81 * 0.1 * 45.0).abs() < 1e-12, "{b}");
+        // Gravity along −x: the heights are the x coordinates, all equal.
+        assert_eq!(releasable(&m, &x, [-9.81, 0.0]), 0.0);
+        assert_eq!(releasable(&m, &x, [0.0, 0.0]), 0.0);
+        assert_eq!(releasable(&[], &[], [0.0, -9.81]), 0.0);
+    }
+
+    #[test]
+    fn no_budget_no_balance() {
+        assert_eq!(EnergyGrowth::start(0.0, 1.0, 0.0), None);
+        assert_eq!(EnergyGrowth::start(0.0, f64::NAN, 2.0), None);
+        assert!(EnergyGrowth::start(0.0, -3.0, 2.0).is_some());
+    }
+
+    #[test]
+    fn the_largest_gain_is_kept_and_the_warning_given_once() {
+        // Numbers exact in binary: a budget of 16 J/m from −4 J/m.
+        let mut g = EnergyGrowth::start(0.0, -4.0, 16.0).unwrap();
+        // Losses leave the largest gain at the start's 0.
+        assert!(!g.observe(0.1, -5.0));
+        assert_eq!((g.largest, g.at), (0.0, 0.0));
+        // A gain of 1/16 of the budget is under the line.
+        assert!(!g.observe(0.2, -3.0));
+        assert_eq!((g.largest, g.at), (0.0625, 0.2));
+        // Past it: warned once, at the first output time past it.
+        assert!(g.observe(0.3, -2.0));
+        assert_eq!((g.largest, g.at), (0.125, 0.3));
+        assert!(!g.observe(0.4, 0.0));
+        assert_eq!((g.largest, g.at), (0.25, 0.4));
+        // Smaller gains, and non-finite energies, leave it.
+        assert!(!g.observe(0.5, -1.0));
+        assert!(!g.observe(0.6, f64::NAN));
+        assert!(!g.observe(0.7, f64::INFINITY));
+        assert_eq!((g.largest, g.at), (0.25, 0.4));
+    }
+}
