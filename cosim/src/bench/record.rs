@@ -5,6 +5,8 @@ use std::path::Path;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
+use contact_broker::energy_balance::WARN_GROWTH;
+
 use super::lobovsky::SensorScore;
 
 /// One bench case's result. A case that failed or blew up is a record too, with `status` and `message`.
@@ -60,6 +62,11 @@ pub struct Record {
     /// Stress cases: the fluid's total energy at the end over its budget (negative: dissipated).
     #[serde(default)]
     pub energy_drift: Option<f64>,
+    /// Every case: the most mechanical energy the fluid and the structure together gained over t = 0, as a fraction
+    /// of the energy the water can release (`summary.json` `energy_growth.largest`); `null` without a fluid under
+    /// gravity. Past [`WARN_GROWTH`] the case made energy and its result is not physical, whatever its error.
+    #[serde(default)]
+    pub energy_made: Option<f64>,
     /// The wall-impact case: each sensor's first impact, peak, RMS after the impact, lowest sample and exact
     /// zeros (`bench/lobovsky.rs`); empty for the other cases.
     #[serde(default)]
@@ -87,10 +94,49 @@ impl Record {
     pub fn ok(&self) -> bool {
         self.status == "ok" && self.error.is_some_and(f64::is_finite)
     }
+
+    /// The status as the report shows it: an `ok` run that made energy says how much (`energy_made`).
+    pub fn status_shown(&self) -> String {
+        match self.energy_made.filter(|g| *g > WARN_GROWTH) {
+            Some(g) if self.status == "ok" => format!("ok, made {:.0} % of its energy budget", 100.0 * g),
+            _ => self.status.clone(),
+        }
+    }
 }
 
 /// Write `records` as a pretty JSON list.
 pub fn write(path: &Path, records: &[Record]) -> anyhow::Result<()> {
     let text = serde_json::to_string_pretty(records)?;
     std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(status: &str, energy_made: Option<f64>) -> Record {
+        let mut r: Record = serde_json::from_str(r#"{"case": "gate", "variant": "", "solver": "isph", "contact": "pp",
+            "spacing": 0.004, "threads": 1, "repeats": 1, "particles": 1, "steps": 1, "coupling_steps": 1, "sim_time": 0.4,
+            "end_time": 0.4, "wall_seconds": 1.0, "process_seconds": 1.0, "particle_steps_per_second": 1.0,
+            "sph_seconds": 1.0, "sph_ns_per_particle_step": 1.0, "metric": "peak", "status": "ok", "message": "",
+            "sets": [], "out": ""}"#)
+        .unwrap();
+        r.status = status.into();
+        r.energy_made = energy_made;
+        r
+    }
+
+    #[test]
+    fn an_ok_case_that_made_energy_says_how_much() {
+        assert_eq!(
+            record("ok", Some(2.655)).status_shown(),
+            "ok, made 266 % of its energy budget"
+        );
+        assert_eq!(record("ok", Some(WARN_GROWTH)).status_shown(), "ok");
+        assert_eq!(record("ok", Some(0.03)).status_shown(), "ok");
+        assert_eq!(record("ok", None).status_shown(), "ok");
+        assert_eq!(record("unstable", Some(3.0)).status_shown(), "unstable");
+        // Older bench.json files have no energy_made.
+        assert_eq!(record("ok", None).energy_made, None);
+    }
 }

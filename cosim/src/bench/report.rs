@@ -190,10 +190,14 @@ fn results_section(md: &mut String, records: &[Record]) {
                 _ => "–".into(),
             },
             mb(r.peak_rss_bytes),
-            r.status,
+            r.status_shown(),
         );
     }
-    md.push_str("\nThe same as `pareto.svg`: error against wall time, one curve per case, solver and contact.\n\n");
+    md.push_str(
+        "\nThe same as `pareto.svg`: error against wall time, one curve per case, solver and contact. A status \"ok, made \
+         … %\" is a run whose fluid and structure gained more than a tenth of the energy the water can release \
+         (`summary.json` `energy_growth`): nothing in a scene supplies it, so its result is not physical.\n\n",
+    );
 }
 
 /// The wall-impact case, per sensor, with issue 16's bounds.

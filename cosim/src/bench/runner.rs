@@ -54,6 +54,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         value: None,
         reference: None,
         energy_growth: None,
+        energy_made: None,
         energy_drift: None,
         sensors: Vec::new(),
         metric: super::suite::describe(case.metric).into(),
@@ -77,6 +78,7 @@ pub fn run_case(case: &Case, out: &Path, scenes: &Path, limit: Duration) -> Reco
         record.sph_ns_per_particle_step = 1e9 * s.timings.sph / particle_steps.max(1.0);
         record.status = s.status.to_string();
         record.message = s.message.clone();
+        record.energy_made = s.energy_growth.as_ref().map(|g| g.largest);
     }
     match outcome {
         Outcome::TimedOut => {
