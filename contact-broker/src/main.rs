@@ -256,6 +256,9 @@ fn serve(
                     s.extra.insert("max_penetration".into(), p.max_penetration.into());
                     s.extra.insert("exchanged".into(), p.exchanged.into());
                 }
+                if let Some(g) = p.energy_made {
+                    s.extra.insert("energy_made".into(), g.into());
+                }
             });
             (last_t, last_step, last_wall) = (p.t, p.step, Instant::now());
         }

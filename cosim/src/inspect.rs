@@ -75,6 +75,18 @@ fn table(doc: &serde_json::Value) -> String {
                     s["extra"].get("exchanged").unwrap_or(&serde_json::Value::Null)
                 );
             }
+            if let Some(g) = s["extra"].get("energy_made").and_then(|g| g.as_f64()) {
+                out += &format!(
+                    "{:<15} energy gained since t = 0: at most {:.2} % of what the water can release{}\n",
+                    "",
+                    100.0 * g,
+                    if g > contact_broker::energy_balance::WARN_GROWTH {
+                        " (made by the scheme: see summary.json energy_growth)"
+                    } else {
+                        ""
+                    }
+                );
+            }
             if let Some(stats) = s["extra"].get("contact_stats") {
                 out += &format!("{:<15} contact_stats {stats}\n", "");
             }

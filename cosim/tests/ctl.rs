@@ -144,6 +144,9 @@ fn break_snapshot_step_and_resume_leave_the_run_bit_identical() {
         "{doc:#}"
     );
     assert_eq!(doc["nodes"]["sph-node"]["step"], step, "{doc:#}");
+    // The energy balance, live: the WCSPH gate gains at most 0.0011 of its budget as shipped (docs/VALIDATION.md).
+    let made = doc["nodes"]["contact-broker"]["extra"]["energy_made"].as_f64();
+    assert!(made.is_some_and(|g| (0.0..0.01).contains(&g)), "{doc:#}");
 
     // A snapshot while paused: the mesh, the particles, the last pass's contacts.
     let snap = dir.join("snapshot");

@@ -20,6 +20,9 @@ pub struct Progress {
     pub max_penetration: f64,
     /// Fluid particles exchanged in the last step (the region of interest).
     pub exchanged: u64,
+    /// The most energy the fluid and the structure together gained so far, as a fraction of the energy the water
+    /// can release (`summary.json` `energy_growth`, taken at the output times); `None` without a fluid under gravity.
+    pub energy_made: Option<f64>,
 }
 
 /// What the run's progress callback answers after each step: go on, or stop the run now for the reason given (the
@@ -41,6 +44,7 @@ pub(super) fn report(
         contacts: contact.last.contacts as u64,
         max_penetration: summary.contact_stats.max_penetration,
         exchanged: contact.last.exchanged as u64,
+        energy_made: summary.energy_growth.as_ref().map(|g| g.largest),
     });
     if let Control::Break(why) = control {
         anyhow::bail!("stopped after coupling step {step} (t = {t} s): {why}");
