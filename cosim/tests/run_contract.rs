@@ -54,6 +54,8 @@ fn processes_run_writes_every_output_of_the_contract() {
     // No fluid, no contact: nothing relaxed, and the key says so.
     assert!(s["reaction_relaxation"].is_null(), "{s}");
     assert!(s["contact_step_bound"].is_null(), "{s}");
+    // No fluid: no water whose releasable energy a gain is measured against.
+    assert!(s["energy_growth"].is_null(), "{s}");
 
     let csv = std::fs::read_to_string(out.join("probes.csv")).unwrap();
     let mut lines = csv.lines();
