@@ -1,8 +1,8 @@
 //! Contact algorithms and the step coordinator of the FEM–SPH co-simulation.
 //!
-//! `coordinator`, `interface`, `relaxation`, `probes`, `energy_balance`, `summary` and `output` are pure (files, no messaging);
-//! `setup` is the set-up of a run that `cosim run` and the `contact-broker` binary share; `transport` is the zenoh
-//! adapter used by the binary.
+//! `coordinator`, `interface`, `relaxation`, `probes`, `energy_balance`, `summary` and `output` are pure (files, no
+//! messaging); `setup` is the set-up of a run that `cosim run` and the `contact-broker` binary share; `transport` is
+//! the zenoh adapter used by the binary.
 #![warn(missing_docs)]
 
 pub mod checkpoint;

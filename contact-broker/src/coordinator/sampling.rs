@@ -146,8 +146,9 @@ impl<'s> Outputs<'s> {
     }
 }
 
-/// The run's energy balance at output time `t`, the `index`-th (`energy_balance.rs`): started at the first,
-/// taken at the others; the first output time whose gain passes [`crate::energy_balance::WARN_GROWTH`] of the budget is logged.
+/// The run's energy balance at output time `t`, the `index`-th (`energy_balance.rs`): started at the first, taken
+/// at the others; the first output time whose gain passes [`crate::energy_balance::WARN_GROWTH`] of the budget is
+/// logged.
 fn energy_balance(
     probes: &Probes,
     t: f64,
@@ -163,9 +164,9 @@ fn energy_balance(
     } else if let Some(growth) = summary.energy_growth.as_mut() {
         if growth.observe(t, energy) {
             tracing::warn!(
-                "by t = {t} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m the \
-                 water can release: nothing in the scene supplies it, so the scheme made it (an unstable coupling, or a \
-                 step too long for it); what follows may be unphysical (summary.json energy_growth)",
+                "by t = {t} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m \
+                 the water can release: nothing in the scene supplies it, so the scheme made it (an unstable \
+                 coupling, or a step too long for it); what follows may be unphysical (summary.json energy_growth)",
                 growth.largest * growth.budget,
                 100.0 * growth.largest,
                 growth.budget

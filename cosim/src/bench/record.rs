@@ -116,8 +116,8 @@ mod tests {
 
     fn record(status: &str, energy_made: Option<f64>) -> Record {
         let mut r: Record = serde_json::from_str(r#"{"case": "gate", "variant": "", "solver": "isph", "contact": "pp",
-            "spacing": 0.004, "threads": 1, "repeats": 1, "particles": 1, "steps": 1, "coupling_steps": 1, "sim_time": 0.4,
-            "end_time": 0.4, "wall_seconds": 1.0, "process_seconds": 1.0, "particle_steps_per_second": 1.0,
+            "spacing": 0.004, "threads": 1, "repeats": 1, "particles": 1, "steps": 1, "coupling_steps": 1,
+            "sim_time": 0.4, "end_time": 0.4, "wall_seconds": 1.0, "process_seconds": 1.0, "particle_steps_per_second": 1.0,
             "sph_seconds": 1.0, "sph_ns_per_particle_step": 1.0, "metric": "peak", "status": "ok", "message": "",
             "sets": [], "out": ""}"#)
         .unwrap();
