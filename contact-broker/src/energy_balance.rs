@@ -3,10 +3,9 @@
 //! energy the water can release.
 //!
 //! Nothing in a scene drives the water or the structure (no moving wall, no inflow, no applied load besides
-//! gravity), so the fluid's kinetic and gravitational energy plus the structure's kinetic, strain and
-//! gravitational energy can only fall: the viscosities, the contact's inelastic velocity correction (Long et al.
-//! 2016, Eq. (12)) take energy out of it, and the WCSPH fluid's elastic energy, which it does not count, only
-//! borrows from it. A gain is energy the numerical scheme
+//! gravity), so the fluid's kinetic, gravitational and (WCSPH) elastic energy plus the structure's kinetic, strain
+//! and gravitational energy can only fall: the viscosities and the contact's inelastic velocity correction (Long et
+//! al. 2016, Eq. (12)) take energy out of it. A gain is energy the numerical scheme
 //! made: the symptom of an unstable coupling, or of a step too long for it, often long before anything blows up
 //! (the coupled ISPH gate at `coupling.max_dt = 1e-2` ends `ok` having gained its whole budget, docs/CORRECTIONS.md
 //! "The structure's own face velocity, sent by the broker"). A run whose gain passes [`WARN_GROWTH`] of the budget
@@ -14,7 +13,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// A gain beyond this fraction of the budget is a warning (once a run). As shipped the scenes gain at most 0.0016
+/// A gain beyond this fraction of the budget is a warning (once a run). As shipped the scenes gain at most 0.0003
 /// with WCSPH, 0.032 with ISPH and 0.079 with ISPH + `particle_particle` (the gate; docs/VALIDATION.md, 2026-11-29
 /// twelfth); the stress tests bound the fluid's own gain by 0.05.
 pub const WARN_GROWTH: f64 = 0.1;
@@ -30,8 +29,9 @@ pub struct EnergyGrowth {
     /// The potential energy the water can release [J/m]: Σ m |g| (h − h_min) over the fluid at t = 0, h the height
     /// against gravity (ρ g W H²/2 less half a spacing's worth for a block W × H on a floor).
     pub budget: f64,
-    /// E(0) [J/m]: the fluid's kinetic energy and its gravitational energy relative to its first positions, plus
-    /// the structure's kinetic, strain and gravitational energy, as the `energy` probes count them.
+    /// E(0) [J/m]: the fluid's kinetic energy, its gravitational energy relative to its first positions and, for
+    /// WCSPH, its elastic energy Σ m e(ρ) (`sph_node::eos::Tait::specific_energy`), plus the structure's kinetic,
+    /// strain and gravitational energy (the `energy` probes count all of these but the elastic energy).
     pub initial: f64,
 }
 

@@ -108,10 +108,11 @@ fn dam_break_error_falls_with_spacing_and_outputs_are_written() {
             "peak RSS of a real process"
         );
         assert!(error(r).is_finite() && error(r) > 0.0);
-        // A dam break only loses energy (the viscosities): what summary.json's balance gained stays at round-off
-        // and the start's settling (measured 0.0016 of the budget at Δx = 2 mm, `docs/VALIDATION.md`).
+        // A dam break only loses energy (the viscosities): summary.json's balance, which counts the WCSPH fluid's
+        // elastic energy, never rises above its start (measured 0 at Δx = 2 mm, `docs/VALIDATION.md`).
         let made = r["energy_made"].as_f64().expect("energy_made");
-        assert!((0.0..0.01).contains(&made), "energy made: {made} of the budget");
+        eprintln!("dam break dx = {}: energy made {made:.2e} of the budget", r["spacing"]);
+        assert!((0.0..1e-3).contains(&made), "energy made: {made} of the budget");
     }
     // 200 particles at Δx = a/10: 7.5 %; 800 at a/20: 3.9 % (mean front error, shifted experiment).
     let (coarse, fine) = (error(&list[0]), error(&list[1]));

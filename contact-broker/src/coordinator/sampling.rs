@@ -8,7 +8,8 @@ use std::time::Instant;
 use anyhow::Context;
 
 use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
-use cosim_proto::scene::LoadedScene;
+use cosim_proto::scene::{FluidSolver, LoadedScene};
+use sph_node::eos::Tait;
 
 use super::exchange::Round;
 use super::inputs::Nodes;
@@ -33,6 +34,8 @@ pub(super) struct Outputs<'s> {
     mesh: Option<Arc<FemMesh>>,
     walls: Option<Arc<Vec<[f64; 2]>>>,
     density: f64,
+    /// The WCSPH fluid's equation of state, for its elastic energy in the energy balance (`None`: ISPH, no fluid).
+    eos: Option<Tait>,
 }
 
 impl<'s> Outputs<'s> {
@@ -61,6 +64,15 @@ impl<'s> Outputs<'s> {
         let walls = nodes.sph.as_ref().map(|n| Arc::new(n.setup().walls.clone()));
         let density = nodes.sph.as_ref().map_or(0.0, |n| n.setup().density);
         let csv = ProbeCsv::create(&out.join("probes.csv"), probes.names())?;
+        let s = &scene.scene;
+        let eos = s
+            .fluid
+            .as_ref()
+            .filter(|f| f.solver == FluidSolver::Wcsph)
+            .and_then(|f| {
+                let c0 = sph_node::setup::sound_speed(f, s.run.gravity).ok()?;
+                Some(Tait::new(f.density, c0))
+            });
         Ok(Self {
             probes,
             csv,
@@ -70,6 +82,7 @@ impl<'s> Outputs<'s> {
             mesh,
             walls,
             density,
+            eos,
         })
     }
 
@@ -111,7 +124,7 @@ impl<'s> Outputs<'s> {
         self.csv.push(t, &values)?;
         self.push_series(t, &values);
         let index = summary.samples as usize;
-        energy_balance(&self.probes, t, index, fem, sph, summary);
+        energy_balance(&self.probes, self.eos.as_ref(), t, index, fem, sph, summary);
         summary.samples += 1;
         if self.run.is_frame(index as u64, last) {
             if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {
@@ -151,13 +164,25 @@ impl<'s> Outputs<'s> {
 /// logged.
 fn energy_balance(
     probes: &Probes,
+    eos: Option<&Tait>,
     t: f64,
     index: usize,
     fem: Option<(&FemMesh, &FemSnapshot)>,
     sph: Option<(&SphSetup, &SphSnapshot)>,
     summary: &mut Summary,
 ) {
-    let energy = probes.mechanical_energy(fem, sph);
+    // The WCSPH fluid stores energy in its compression too (Tait::specific_energy): counted, or the balance would
+    // read each acoustic swing between kinetic and elastic energy as a gain.
+    let elastic = match (eos, sph) {
+        (Some(eos), Some((_, s))) => {
+            s.m.iter()
+                .zip(&s.rho)
+                .map(|(m, rho)| m * eos.specific_energy(*rho))
+                .sum()
+        }
+        _ => 0.0,
+    };
+    let energy = probes.mechanical_energy(fem, sph) + elastic;
     if index == 0 {
         let budget = sph.map_or(0.0, |(_, s)| releasable(&s.m, &s.x, probes.gravity()));
         summary.energy_growth = EnergyGrowth::start(t, energy, budget);
