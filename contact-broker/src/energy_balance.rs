@@ -11,12 +11,19 @@
 //! "The structure's own face velocity, sent by the broker"). A run whose gain passes [`WARN_GROWTH`] of the budget
 //! says so once in its log while it runs; every run with a fluid under gravity reports its largest gain.
 
+use cosim_proto::scene::{FluidSolver, Scene};
 use serde::{Deserialize, Serialize};
+use sph_node::eos::Tait;
 
 /// A gain beyond this fraction of the budget is a warning (once a run). As shipped the scenes gain at most 0.0003
 /// with WCSPH, 0.032 with ISPH and 0.079 with ISPH + `particle_particle` (the gate; docs/VALIDATION.md, 2026-11-29
 /// twelfth); the stress tests bound the fluid's own gain by 0.05.
 pub const WARN_GROWTH: f64 = 0.1;
+
+/// Whether a largest gain of `largest` (a fraction of the budget) is energy the scheme made: past [`WARN_GROWTH`].
+pub fn made_energy(largest: f64) -> bool {
+    largest > WARN_GROWTH
+}
 
 /// The largest energy gain of a run so far (`summary.json` `energy_growth`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -54,11 +61,26 @@ impl EnergyGrowth {
         if !(energy.is_finite() && gain > self.largest) {
             return false;
         }
-        let crossed = self.largest <= WARN_GROWTH && gain > WARN_GROWTH;
+        let crossed = !made_energy(self.largest) && made_energy(gain);
         self.largest = gain;
         self.at = t;
         crossed
     }
+}
+
+/// The equation of state of the scene's fluid where it stores elastic energy (WCSPH: the Tait law with the scene's
+/// c0, as the fluid node takes it); `None` for ISPH and without a fluid.
+pub fn elastic_eos(scene: &Scene) -> Option<Tait> {
+    let fluid = scene.fluid.as_ref().filter(|f| f.solver == FluidSolver::Wcsph)?;
+    let c0 = sph_node::setup::sound_speed(fluid, scene.run.gravity).ok()?;
+    Some(Tait::new(fluid.density, c0))
+}
+
+/// The elastic energy of particles of masses `m` and densities `rho` [J/m]: Σ m e(ρ) (`Tait::specific_energy`).
+/// Counted, or the balance would read each acoustic swing between kinetic and elastic energy as a gain, and the
+/// release of the hydrostatic compression a WCSPH column starts with as one.
+pub fn elastic_energy(eos: &Tait, m: &[f64], rho: &[f64]) -> f64 {
+    m.iter().zip(rho).map(|(m, rho)| m * eos.specific_energy(*rho)).sum()
 }
 
 /// The potential energy particles of masses `m` at `x` release under `gravity` falling to the height of the lowest

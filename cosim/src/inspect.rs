@@ -80,7 +80,7 @@ fn table(doc: &serde_json::Value) -> String {
                     "{:<15} energy gained since t = 0: at most {:.2} % of what the water can release{}\n",
                     "",
                     100.0 * g,
-                    if g > contact_broker::energy_balance::WARN_GROWTH {
+                    if contact_broker::energy_balance::made_energy(g) {
                         " (made by the scheme: see summary.json energy_growth)"
                     } else {
                         ""

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use contact_broker::coordinator::{Nodes, RunInfo};
-use contact_broker::energy_balance::WARN_GROWTH;
+use contact_broker::energy_balance::made_energy;
 use contact_broker::link::NodeLink;
 use contact_broker::recorder::{Recorded, Recorder, Tap};
 use contact_broker::setup::RunSetup;
@@ -152,7 +152,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             out.display()
         );
         // Ok, but not to be trusted without a look: energy the scheme made (`contact_broker::energy_balance`).
-        if let Some(g) = summary.energy_growth.as_ref().filter(|g| g.largest > WARN_GROWTH) {
+        if let Some(g) = summary.energy_growth.as_ref().filter(|g| made_energy(g.largest)) {
             eprintln!(
                 "cosim: warning: the fluid and the structure gained {:.1} % of the {:.4} J/m the water can release \
                  (the most at t = {} s), which nothing in the scene supplies: the numerical scheme made it; see \

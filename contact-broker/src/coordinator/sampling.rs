@@ -8,13 +8,13 @@ use std::time::Instant;
 use anyhow::Context;
 
 use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
-use cosim_proto::scene::{FluidSolver, LoadedScene};
+use cosim_proto::scene::LoadedScene;
 use sph_node::eos::Tait;
 
 use super::exchange::Round;
 use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
-use crate::energy_balance::{releasable, EnergyGrowth};
+use crate::energy_balance::{elastic_energy, elastic_eos, releasable, EnergyGrowth};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
@@ -64,15 +64,7 @@ impl<'s> Outputs<'s> {
         let walls = nodes.sph.as_ref().map(|n| Arc::new(n.setup().walls.clone()));
         let density = nodes.sph.as_ref().map_or(0.0, |n| n.setup().density);
         let csv = ProbeCsv::create(&out.join("probes.csv"), probes.names())?;
-        let s = &scene.scene;
-        let eos = s
-            .fluid
-            .as_ref()
-            .filter(|f| f.solver == FluidSolver::Wcsph)
-            .and_then(|f| {
-                let c0 = sph_node::setup::sound_speed(f, s.run.gravity).ok()?;
-                Some(Tait::new(f.density, c0))
-            });
+        let eos = elastic_eos(&scene.scene);
         Ok(Self {
             probes,
             csv,
@@ -171,15 +163,8 @@ fn energy_balance(
     sph: Option<(&SphSetup, &SphSnapshot)>,
     summary: &mut Summary,
 ) {
-    // The WCSPH fluid stores energy in its compression too (Tait::specific_energy): counted, or the balance would
-    // read each acoustic swing between kinetic and elastic energy as a gain.
     let elastic = match (eos, sph) {
-        (Some(eos), Some((_, s))) => {
-            s.m.iter()
-                .zip(&s.rho)
-                .map(|(m, rho)| m * eos.specific_energy(*rho))
-                .sum()
-        }
+        (Some(eos), Some((_, s))) => elastic_energy(eos, &s.m, &s.rho),
         _ => 0.0,
     };
     let energy = probes.mechanical_energy(fem, sph) + elastic;

@@ -139,11 +139,8 @@ fn progress_line(r: &record::Record) -> String {
     if let (Some(g), Some(d)) = (r.energy_growth, r.energy_drift) {
         line += &format!(", energy max {g:+.4} end {d:+.4} of the budget");
     }
-    if let Some(g) = r
-        .energy_made
-        .filter(|g| *g > contact_broker::energy_balance::WARN_GROWTH)
-    {
-        line += &format!(", made {:.0} % of its energy budget", 100.0 * g);
+    if let Some(note) = r.energy_note() {
+        line += &format!(", {note}");
     }
     if let Some(b) = r.peak_rss_bytes {
         line += &format!(", peak RSS {:.1} MB", b as f64 / 1048576.0);

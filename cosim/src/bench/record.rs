@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
-use contact_broker::energy_balance::WARN_GROWTH;
+use contact_broker::energy_balance::made_energy;
 
 use super::lobovsky::SensorScore;
 
@@ -64,7 +64,7 @@ pub struct Record {
     pub energy_drift: Option<f64>,
     /// Every case: the most mechanical energy the fluid and the structure together gained over t = 0, as a fraction
     /// of the energy the water can release (`summary.json` `energy_growth.largest`); `null` without a fluid under
-    /// gravity. Past [`WARN_GROWTH`] the case made energy and its result is not physical, whatever its error.
+    /// gravity. Past `energy_balance::WARN_GROWTH` the case made energy and its result is not physical, whatever its error.
     #[serde(default)]
     pub energy_made: Option<f64>,
     /// The wall-impact case: each sensor's first impact, peak, RMS after the impact, lowest sample and exact
@@ -95,10 +95,16 @@ impl Record {
         self.status == "ok" && self.error.is_some_and(f64::is_finite)
     }
 
-    /// The status as the report shows it: an `ok` run that made energy says how much (`energy_made`).
+    /// "made N % of its energy budget" where the case made energy (`energy_made`); `None` otherwise.
+    pub fn energy_note(&self) -> Option<String> {
+        let made = self.energy_made.filter(|g| made_energy(*g))?;
+        Some(format!("made {:.0} % of its energy budget", 100.0 * made))
+    }
+
+    /// The status as the report shows it: an `ok` run that made energy says how much ([`Record::energy_note`]).
     pub fn status_shown(&self) -> String {
-        match self.energy_made.filter(|g| *g > WARN_GROWTH) {
-            Some(g) if self.status == "ok" => format!("ok, made {:.0} % of its energy budget", 100.0 * g),
+        match self.energy_note() {
+            Some(note) if self.status == "ok" => format!("ok, {note}"),
             _ => self.status.clone(),
         }
     }
@@ -132,7 +138,10 @@ mod tests {
             record("ok", Some(2.655)).status_shown(),
             "ok, made 266 % of its energy budget"
         );
-        assert_eq!(record("ok", Some(WARN_GROWTH)).status_shown(), "ok");
+        assert_eq!(
+            record("ok", Some(contact_broker::energy_balance::WARN_GROWTH)).status_shown(),
+            "ok"
+        );
         assert_eq!(record("ok", Some(0.03)).status_shown(), "ok");
         assert_eq!(record("ok", None).status_shown(), "ok");
         assert_eq!(record("unstable", Some(3.0)).status_shown(), "unstable");
