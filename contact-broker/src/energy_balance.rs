@@ -25,6 +25,22 @@ pub fn made_energy(largest: f64) -> bool {
     largest > WARN_GROWTH
 }
 
+/// The coupling step to try after a run of `steps` coupling steps to `sim_time` made energy: half its mean step,
+/// rounded down to one significant digit (`None` without a step). On the gate a shorter coupling step took the energy
+/// made back within the bound: WCSPH at Δx = 4.5 mm 0.113 of its budget → 0 at the step this suggests (3e-5; its own
+/// steps averaged 6.7e-5 s), ISPH at `coupling.max_dt` 1e-2 1.057 → 0.057 (7e-5). Not ISPH + `particle_particle` at
+/// Δx = 4 mm: 2.66 → 2.31 at 2e-5 (docs/VALIDATION.md, 2026-11-29 thirteenth).
+pub fn shorter_step(sim_time: f64, steps: u64) -> Option<f64> {
+    if steps == 0 || sim_time.is_nan() || sim_time <= 0.0 {
+        return None;
+    }
+    let half = 0.5 * sim_time / steps as f64;
+    let unit = 10f64.powf(half.log10().floor());
+    // A digit from 1 to 9 (the guard: a power of ten whose logarithm rounds below it)
+    let digit = (half / unit * (1.0 + 1e-12)).floor().clamp(1.0, 9.0);
+    Some(digit * unit)
+}
+
 /// The largest energy gain of a run so far (`summary.json` `energy_growth`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EnergyGrowth {
@@ -99,6 +115,18 @@ pub fn releasable(m: &[f64], x: &[[f64; 2]], gravity: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_step_to_try_is_half_the_mean_step_to_one_digit() {
+        // 0.4 s in 6,012 steps: 6.65e-5 s a step, half of it 3.33e-5 → 3e-5.
+        let dt = shorter_step(0.4, 6012).unwrap();
+        assert!((dt - 3e-5).abs() < 1e-18, "{dt}");
+        // 0.2 s in 1,000 steps: 2e-4 a step, 1e-4 exactly (no rounding below it).
+        let dt = shorter_step(0.2, 1000).unwrap();
+        assert!((dt - 1e-4).abs() < 1e-18, "{dt}");
+        assert_eq!(shorter_step(0.0, 10), None);
+        assert_eq!(shorter_step(0.1, 0), None);
+    }
 
     #[test]
     fn the_budget_of_a_column_is_its_weight_times_its_height_over_two() {

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use contact_broker::coordinator::{Nodes, RunInfo};
-use contact_broker::energy_balance::made_energy;
+use contact_broker::energy_balance::{made_energy, shorter_step};
 use contact_broker::link::NodeLink;
 use contact_broker::recorder::{Recorded, Recorder, Tap};
 use contact_broker::setup::RunSetup;
@@ -161,6 +161,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                 g.budget,
                 g.at
             );
+            if let Some(dt) = shorter_step(summary.sim_time, summary.steps) {
+                eprintln!(
+                    "cosim: a shorter coupling step is the first thing to try: this run's averaged {:.2e} s, e.g. \
+                     --set coupling.max_dt={dt:.0e}",
+                    summary.sim_time / summary.steps as f64
+                );
+            }
         }
         Ok(ExitCode::SUCCESS)
     } else {
