@@ -14,7 +14,7 @@ use sph_node::eos::Tait;
 use super::exchange::Round;
 use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
-use crate::energy_balance::{elastic_energy, elastic_eos, releasable, EnergyGrowth};
+use crate::energy_balance::{elastic_energy, elastic_eos, releasable, shorter_step, EnergyGrowth};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
@@ -173,10 +173,19 @@ fn energy_balance(
         summary.energy_growth = EnergyGrowth::start(t, energy, budget);
     } else if let Some(growth) = summary.energy_growth.as_mut() {
         if growth.observe(t, energy) {
+            // The step to try, from the steps so far (`cosim run` names it again after the run, from all of them).
+            let hint = shorter_step(summary.sim_time, summary.steps).map_or(String::new(), |dt| {
+                format!(
+                    "; a shorter coupling step is the first thing to try (the steps so far averaged {:.2e} s: \
+                     coupling.max_dt = {dt:.0e})",
+                    summary.sim_time / summary.steps as f64
+                )
+            });
             tracing::warn!(
                 "by t = {t} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m \
                  the water can release: nothing in the scene supplies it, so the scheme made it (an unstable \
-                 coupling, or a step too long for it); what follows may be unphysical (summary.json energy_growth)",
+                 coupling, or a step too long for it); what follows may be unphysical (summary.json \
+                 energy_growth){hint}",
                 growth.largest * growth.budget,
                 100.0 * growth.largest,
                 growth.budget
