@@ -93,8 +93,9 @@ fn main() {
                     .unwrap();
                 let text = String::from_utf8_lossy(&out.stdout);
                 let fields: Vec<String> = text.split_whitespace().map(str::to_string).collect();
+                // cpu_s steps it_mean it_max particles wall_s (`child`)
                 assert!(
-                    fields.len() == 5,
+                    fields.len() == 6,
                     "child {solver} at {spacing}: {text} {}",
                     String::from_utf8_lossy(&out.stderr)
                 );
