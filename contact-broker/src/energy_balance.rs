@@ -25,20 +25,33 @@ pub fn made_energy(largest: f64) -> bool {
     largest > WARN_GROWTH
 }
 
+/// A run's mean coupling step and the one to try after it made energy ([`shorter_step`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepHint {
+    /// The run's mean coupling step [s].
+    pub mean: f64,
+    /// Half of it, rounded down to one significant digit [s].
+    pub try_dt: f64,
+}
+
 /// The coupling step to try after a run of `steps` coupling steps to `sim_time` made energy: half its mean step,
 /// rounded down to one significant digit (`None` without a step). On the gate a shorter coupling step took the energy
 /// made back within the bound: WCSPH at Δx = 4.5 mm 0.113 of its budget → 0 at the step this suggests (3e-5; its own
 /// steps averaged 6.7e-5 s), ISPH at `coupling.max_dt` 1e-2 1.057 → 0.057 (7e-5). Not ISPH + `particle_particle` at
 /// Δx = 4 mm: 2.66 → 2.31 at 2e-5 (docs/VALIDATION.md, 2026-11-29 thirteenth).
-pub fn shorter_step(sim_time: f64, steps: u64) -> Option<f64> {
+pub fn shorter_step(sim_time: f64, steps: u64) -> Option<StepHint> {
     if steps == 0 || sim_time.is_nan() || sim_time <= 0.0 {
         return None;
     }
-    let half = 0.5 * sim_time / steps as f64;
+    let mean = sim_time / steps as f64;
+    let half = 0.5 * mean;
     let unit = 10f64.powf(half.log10().floor());
     // A digit from 1 to 9 (the guard: a power of ten whose logarithm rounds below it)
     let digit = (half / unit * (1.0 + 1e-12)).floor().clamp(1.0, 9.0);
-    Some(digit * unit)
+    Some(StepHint {
+        mean,
+        try_dt: digit * unit,
+    })
 }
 
 /// The largest energy gain of a run so far (`summary.json` `energy_growth`).
@@ -119,10 +132,10 @@ mod tests {
     #[test]
     fn the_step_to_try_is_half_the_mean_step_to_one_digit() {
         // 0.4 s in 6,012 steps: 6.65e-5 s a step, half of it 3.33e-5 → 3e-5.
-        let dt = shorter_step(0.4, 6012).unwrap();
+        let dt = shorter_step(0.4, 6012).unwrap().try_dt;
         assert!((dt - 3e-5).abs() < 1e-18, "{dt}");
         // 0.2 s in 1,000 steps: 2e-4 a step, 1e-4 exactly (no rounding below it).
-        let dt = shorter_step(0.2, 1000).unwrap();
+        let dt = shorter_step(0.2, 1000).unwrap().try_dt;
         assert!((dt - 1e-4).abs() < 1e-18, "{dt}");
         assert_eq!(shorter_step(0.0, 10), None);
         assert_eq!(shorter_step(0.1, 0), None);

@@ -161,11 +161,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                 g.budget,
                 g.at
             );
-            if let Some(dt) = shorter_step(summary.sim_time, summary.steps) {
+            if let Some(h) = shorter_step(summary.sim_time, summary.steps) {
                 eprintln!(
                     "cosim: a shorter coupling step is the first thing to try: this run's averaged {:.2e} s, e.g. \
-                     --set coupling.max_dt={dt:.0e}",
-                    summary.sim_time / summary.steps as f64
+                     --set coupling.max_dt={:.0e}",
+                    h.mean, h.try_dt
                 );
             }
         }

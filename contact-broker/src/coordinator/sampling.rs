@@ -174,11 +174,11 @@ fn energy_balance(
     } else if let Some(growth) = summary.energy_growth.as_mut() {
         if growth.observe(t, energy) {
             // The step to try, from the steps so far (`cosim run` names it again after the run, from all of them).
-            let hint = shorter_step(summary.sim_time, summary.steps).map_or(String::new(), |dt| {
+            let hint = shorter_step(summary.sim_time, summary.steps).map_or(String::new(), |h| {
                 format!(
                     "; a shorter coupling step is the first thing to try (the steps so far averaged {:.2e} s: \
-                     coupling.max_dt = {dt:.0e})",
-                    summary.sim_time / summary.steps as f64
+                     coupling.max_dt = {:.0e})",
+                    h.mean, h.try_dt
                 )
             });
             tracing::warn!(
