@@ -556,9 +556,11 @@ fn isph_at_twice_its_step_stays_within_the_energy_bound() {
 /// 2026-11-28 (ninth): at 1e-2 the gain is chaotic, 0.533 / 0.055 / 0.017 of the budget with outputs every 5 / 2 / 1
 /// ms (which end coupling steps elsewhere); the structure's own face velocity, sent by the broker, does not hold it
 /// at every setting either (docs/CORRECTIONS.md "The structure's own face velocity, sent by the broker").
-/// The gate of `assert_isph_gate` at `coupling.max_dt` with the structure's energy as the first probe.
-fn isph_gate(max_dt: &str) -> Outcome {
+/// The gate of `assert_isph_gate` at `coupling.max_dt` with the structure's energy as the first probe, and `more`
+/// settings.
+fn isph_gate(max_dt: &str, more: &[&str]) -> Outcome {
     let mut sets = gate(GATE_E, &["fluid.solver=isph", &format!("coupling.max_dt={max_dt}")]);
+    sets.extend(more.iter().map(|s| s.to_string()));
     sets.push("probe[0]={name=\"structure\",kind=\"energy\",part=\"total\",of=\"structure\"}".into());
     run(
         &format!("gate-isph-{}", max_dt.replace('-', "m")),
@@ -613,10 +615,14 @@ fn assert_energy_balance(case: &str, out: &Outcome) -> f64 {
 /// the symptom the summary's `energy_growth` and the warning are for (`contact_broker::energy_balance`). The warning
 /// names a coupling step to try, half the run's mean step to one digit (`energy_balance::shorter_step`: 1.54e-4 s
 /// here, so 7e-5), and the same gate run at that step stays within the bound (measured: 0.057 of the budget).
+/// Both runs solve the pressure to 1e-8, the tolerance these figures were measured at: at the default 1e-6 the
+/// gain at 1e-2 grows past twice the budget and the fluid node stops the run as unstable at t = 0.158 s (the
+/// trajectory of an overlong coupling step follows the last bits; measured 2026-11-29, fourteenth session).
 #[test]
 fn a_run_that_makes_energy_says_so() {
+    const TIGHT: &str = "fluid.ppe_tolerance=1e-8";
     let case = "elastic gate isph, coupling.max_dt = 1e-2";
-    let out = isph_gate("1e-2");
+    let out = isph_gate("1e-2", &[TIGHT]);
     out.assert_ok_and_finite(case);
     let growth = assert_energy_balance(case, &out);
     assert!(
@@ -641,7 +647,7 @@ fn a_run_that_makes_energy_says_so() {
         "{case}: suggested {hint} for a mean step of {mean:e} s"
     );
     let case = format!("elastic gate isph, coupling.max_dt = {hint} (the step suggested)");
-    let out = isph_gate(hint);
+    let out = isph_gate(hint, &[TIGHT]);
     out.assert_ok_and_finite(&case);
     let growth = assert_energy_balance(&case, &out);
     assert!(
@@ -651,7 +657,10 @@ fn a_run_that_makes_energy_says_so() {
 }
 
 #[test]
-#[ignore = "found by this test: at max_dt 1e-2 the coupled ISPH gate's fluid gains 53 % of its budget (2026-11-28 \
+#[ignore = "found by this test: at max_dt 1e-2 the coupled ISPH gate goes unstable at t = 0.158 s, its kinetic \
+            energy past twice the budget, with the pressure solved to the default 1e-6 (2026-11-29 fourteenth; to \
+            1e-8 it gains 105.7 % of the budget and ends ok, a_run_that_makes_energy_says_so); \
+            before: the fluid gained 53 % of its budget (2026-11-28 \
             eighth; at 1e-4 +0.03 %, from 6.4 %, since inherited contact faces must stand for the structure near the \
             particle, docs/CORRECTIONS.md \"The coupled ISPH gate creates energy\"); before: 6.4 % at 1e-4 \
             (2026-11-28, free-surface rows blended; \
@@ -680,7 +689,7 @@ fn assert_isph_gate(max_dt: &str) {
     let budget = budget(&GATE_BLOCKS);
     let releasable = releasable(&GATE_BLOCKS, GATE_FLOOR);
     let case = format!("elastic gate isph, coupling.max_dt = {max_dt}");
-    let out = isph_gate(max_dt);
+    let out = isph_gate(max_dt, &[]);
     out.assert_ok_and_finite(&case);
     let growth = assert_energy_balance(&case, &out);
     assert!(

@@ -141,6 +141,32 @@ fn fluid_cfl_defaults_to_one_and_is_refused_above_one() {
 }
 
 #[test]
+fn ppe_tolerance_is_for_isph_in_its_range_and_defaults_to_1e_6() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/dam_break.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let isph = "fluid.solver=\"isph\"";
+    let s = parse("d.toml", &text, &[isph.into()]).unwrap();
+    assert_eq!(s.fluid.as_ref().unwrap().ppe_tolerance(), 1e-6);
+    assert!(!s.to_toml().lines().any(|l| l.starts_with("ppe_tolerance")));
+    let s = parse("d.toml", &text, &[isph.into(), "fluid.ppe_tolerance=1e-8".into()]).unwrap();
+    assert_eq!(s.fluid.as_ref().unwrap().ppe_tolerance(), 1e-8);
+    assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    for bad in ["1e-2", "1e-13", "0", "-1e-6", "nan"] {
+        let e = err(&text, &[isph, &format!("fluid.ppe_tolerance={bad}")]);
+        assert!(
+            e.starts_with("f.toml: fluid.ppe_tolerance: must be in [1e-12, 1e-3]"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    let e = err(&text, &["fluid.ppe_tolerance=1e-6"]);
+    assert_eq!(
+        e, "f.toml: fluid.ppe_tolerance: applies to solver = \"isph\" only",
+        "{e}"
+    );
+}
+
+#[test]
 fn frame_interval_is_a_whole_multiple_of_the_output_interval() {
     let s = parse("f.toml", SCENE, &[]).unwrap();
     assert_eq!(

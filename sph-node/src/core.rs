@@ -6,12 +6,12 @@ use std::time::Instant;
 
 use bincode::Options;
 use cosim_proto::messages::{ContactFace, Correction, SphSetup, SphSnapshot, SphState, StepCommand};
-use cosim_proto::scene::{FluidSolver as SceneSolver, PpeSourceKind, Scene};
+use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::error::SphError;
 use crate::fluid_solver::{FluidSolver, SavedSolver};
-use crate::isph::{IsphSolver, PpeSource};
+use crate::isph::IsphSolver;
 use crate::sensors::{IntervalSensors, PressureField, SensorLog};
 use crate::setup;
 use crate::stability::EnergyGuard;
@@ -63,13 +63,7 @@ pub fn solver_from_scene(scene: &Scene) -> Result<Box<dyn FluidSolver>, SphError
     let spec = setup::fluid_spec_any(scene)?;
     Ok(match spec.solver {
         SceneSolver::Wcsph => Box::new(WcsphSolver::new(scene)?),
-        SceneSolver::Isph => Box::new(IsphSolver::with_source(
-            scene,
-            match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
-                PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
-                PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
-            },
-        )?),
+        SceneSolver::Isph => Box::new(IsphSolver::new(scene)?),
     })
 }
 

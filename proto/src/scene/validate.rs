@@ -4,7 +4,8 @@
 use std::collections::HashSet;
 
 use super::schema::{
-    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, SCENE_VERSION,
+    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec,
+    ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION,
 };
 use super::sizing::Sizing;
 use crate::overlap;
@@ -96,12 +97,25 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Res
             || "fluid.density_filter".into(),
             || "ISPH takes no density filter (its pressure comes from the Poisson equation); set \"none\"".into(),
         )?;
-    } else {
         check(
-            f.ppe_source.is_none(),
-            || "fluid.ppe_source".into(),
-            || "applies to solver = \"isph\" only".into(),
+            f.ppe_tolerance().is_finite() && ISPH_PPE_TOLERANCE_RANGE.contains(&f.ppe_tolerance()),
+            || "fluid.ppe_tolerance".into(),
+            || {
+                format!(
+                    "must be in [{:e}, {:e}] (the pressure solve's relative residual), got {}",
+                    ISPH_PPE_TOLERANCE_RANGE.start(),
+                    ISPH_PPE_TOLERANCE_RANGE.end(),
+                    f.ppe_tolerance()
+                )
+            },
         )?;
+    } else {
+        for (set, key) in [
+            (f.ppe_source.is_some(), "fluid.ppe_source"),
+            (f.ppe_tolerance.is_some(), "fluid.ppe_tolerance"),
+        ] {
+            check(!set, || key.into(), || "applies to solver = \"isph\" only".into())?;
+        }
     }
     check(
         !f.blocks.is_empty(),

@@ -73,7 +73,8 @@ pub struct IsphOptions {
     /// Preconditioner of the PPE's BiCGSTAB.
     #[serde(default)]
     pub preconditioner: Preconditioning,
-    /// Relative tolerance of the Jacobi-preconditioned residual, ‖D⁻¹(b − A p)‖₂ ≤ tol ‖D⁻¹ b‖₂.
+    /// Relative tolerance of the Jacobi-preconditioned residual, ‖D⁻¹(b − A p)‖₂ ≤ tol ‖D⁻¹ b‖₂ (the scene's
+    /// `fluid.ppe_tolerance`; default [`cosim_proto::scene::ISPH_PPE_TOLERANCE_DEFAULT`]).
     pub tolerance: f64,
     /// BiCGSTAB iterations before [`crate::SphError::PpeNotConverged`].
     pub max_iterations: usize,
@@ -90,7 +91,7 @@ impl Default for IsphOptions {
             source: PpeSource::DivergenceFree,
             density_relaxation: 0.01,
             preconditioner: Preconditioning::default(),
-            tolerance: 1e-8,
+            tolerance: cosim_proto::scene::ISPH_PPE_TOLERANCE_DEFAULT,
             max_iterations: 2000,
             courant: 0.2,
             free_surface_threshold: free_surface::THRESHOLD_2D,

@@ -12,7 +12,7 @@
 //!
 //! The fluid is incompressible: ρ = ρ0 for fluid and walls throughout.
 
-use cosim_proto::scene::{ContactAlgorithm, FluidSolver as SceneSolver, Scene};
+use cosim_proto::scene::{ContactAlgorithm, FluidSolver as SceneSolver, PpeSourceKind, Scene};
 use rayon::prelude::*;
 
 use super::contact::{ContactLayer, ContactRow};
@@ -99,17 +99,27 @@ pub struct IsphSolver {
 }
 
 impl IsphSolver {
-    /// Builds particles and walls from the scene (`fluid.solver` must be `isph`); divergence-free source.
+    /// Builds particles and walls from the scene (`fluid.solver` must be `isph`), with the scene's PPE source
+    /// (`fluid.ppe_source`, default divergence-free) and tolerance (`fluid.ppe_tolerance`).
     pub fn new(scene: &Scene) -> Result<Self> {
-        Self::with_options(scene, IsphOptions::default())
+        let spec = setup::fluid_spec(scene, SceneSolver::Isph)?;
+        Self::with_source(
+            scene,
+            match spec.ppe_source.unwrap_or(PpeSourceKind::DivergenceFree) {
+                PpeSourceKind::DivergenceFree => PpeSource::DivergenceFree,
+                PpeSourceKind::DensityInvariant => PpeSource::DensityInvariant,
+            },
+        )
     }
 
     /// As [`IsphSolver::new`] with the given PPE source.
     pub fn with_source(scene: &Scene, source: PpeSource) -> Result<Self> {
+        let spec = setup::fluid_spec(scene, SceneSolver::Isph)?;
         Self::with_options(
             scene,
             IsphOptions {
                 source,
+                tolerance: spec.ppe_tolerance(),
                 ..IsphOptions::default()
             },
         )

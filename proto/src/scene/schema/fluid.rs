@@ -80,6 +80,10 @@ pub struct FluidSpec {
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ppe_source: Option<PpeSourceKind>,
+    /// Relative tolerance of the ISPH pressure solve (isph only): BiCGSTAB stops when the Jacobi-scaled residual
+    /// ‖D⁻¹(b − A p)‖ is at most this times ‖D⁻¹ b‖. In [1e-12, 1e-3]; default [`ISPH_PPE_TOLERANCE_DEFAULT`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ppe_tolerance: Option<f64>,
     /// Safety factor on the fluid's stable step: the node steps at `cfl` times the step of `DESIGN.md` §4.2
     /// (WCSPH: min of the acoustic, force and viscous limits) or §4.3 (ISPH: C h / v_max with the same force and
     /// viscous limits). In (0, 1], default 1 (the limit itself); a value above 1 is refused, since the limit is
@@ -130,7 +134,20 @@ pub const WCSPH_APD_DEFAULT: f64 = 0.04;
 /// APD β of ISPH when the scene names none: the paper's, as for WCSPH.
 pub const ISPH_APD_DEFAULT: f64 = 0.04;
 
+/// Tolerance of the ISPH pressure solve when the scene names none (`fluid.ppe_tolerance`). 1e-6: at 1e-8 the solve
+/// took 40 % more iterations for impact pressures, levels and coupled results that moved within their run-to-run
+/// scatter (docs/PERFORMANCE.md, "ISPH: the pressure solve's tolerance").
+pub const ISPH_PPE_TOLERANCE_DEFAULT: f64 = 1e-6;
+
+/// The range `fluid.ppe_tolerance` may take.
+pub const ISPH_PPE_TOLERANCE_RANGE: std::ops::RangeInclusive<f64> = 1e-12..=1e-3;
+
 impl FluidSpec {
+    /// The ISPH pressure solve's relative tolerance: the scene's, or [`ISPH_PPE_TOLERANCE_DEFAULT`].
+    pub fn ppe_tolerance(&self) -> f64 {
+        self.ppe_tolerance.unwrap_or(ISPH_PPE_TOLERANCE_DEFAULT)
+    }
+
     /// APD β in force: the scene's, or the per-solver default (WCSPH [`WCSPH_APD_DEFAULT`], ISPH
     /// [`ISPH_APD_DEFAULT`]).
     pub fn apd(&self) -> f64 {

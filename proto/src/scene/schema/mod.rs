@@ -11,7 +11,10 @@ use serde::{Deserialize, Serialize};
 
 pub use contact::{ContactAlgorithm, ContactSpec};
 pub use coupling::CouplingSpec;
-pub use fluid::{DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, WCSPH_APD_DEFAULT};
+pub use fluid::{
+    DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT,
+    ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT,
+};
 pub use probe::{Average, Component, EnergyOf, EnergyPart, ProbeKind, ProbeSpec, ReferenceSpec};
 pub use solid::{ElementKind, MaterialModel, MaterialSpec, SolidSpec};
 
