@@ -135,8 +135,8 @@ pub const WCSPH_APD_DEFAULT: f64 = 0.04;
 pub const ISPH_APD_DEFAULT: f64 = 0.04;
 
 /// Tolerance of the ISPH pressure solve when the scene names none (`fluid.ppe_tolerance`). 1e-6: at 1e-8 the solve
-/// took 40 % more iterations for impact pressures, levels and coupled results that moved within their run-to-run
-/// scatter (docs/PERFORMANCE.md, "ISPH: the pressure solve's tolerance").
+/// took 40 % more iterations for impact pressures, levels and coupled results that moved within their bounds and
+/// their run-to-run scatter (docs/VALIDATION.md, 2026-11-29 fourteenth).
 pub const ISPH_PPE_TOLERANCE_DEFAULT: f64 = 1e-6;
 
 /// The range `fluid.ppe_tolerance` may take.
