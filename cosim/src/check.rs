@@ -65,6 +65,13 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "coupling_dt_bounded_by_contact": contact_bound,
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
+            // A fluid particle's mass over one mesh cell's, per solid (proto::scene::mass_ratio).
+            "particle_to_cell_mass": s
+                .particle_to_cell_mass()
+                .into_iter()
+                .map(|(name, r)| (name.to_string(), serde_json::json!(r)))
+                .collect::<serde_json::Map<_, _>>(),
+            "warnings": s.heavy_particle_warnings(),
             "frames": frames,
             "samples": samples,
             "probes": s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
@@ -152,6 +159,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "  steps: coupling dt {dt} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
         ),
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
+    }
+    for (name, ratio) in s.particle_to_cell_mass() {
+        println!("  contact: a fluid particle weighs {ratio:.1} cells of solid {name}");
+    }
+    for w in s.heavy_particle_warnings() {
+        println!("  warning: {w}");
     }
     if contact_bound {
         println!(

@@ -117,6 +117,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         launch::ensure_run_id_free(connect, args.zenoh_config.as_deref(), &info.run_id)?;
     }
     prepare_out(&out, scene, &info, own_folder)?;
+    // Not refused: a mesh that fine for this fluid runs, but its energy is not to be trusted (mass_ratio.rs).
+    for w in scene.scene.heavy_particle_warnings() {
+        eprintln!("cosim: warning: {w}");
+    }
     let bar = Bar::new(args.quiet);
     let result = if args.in_process {
         run_in_process(args, &setup, &info, &bar)

@@ -240,6 +240,60 @@ fn check_says_when_the_contact_bounds_the_step() {
     );
 }
 
+/// `cosim check` says how many mesh cells of each solid a fluid particle weighs (ρ Δx² / (ρ_s w h / (nx ny))): the
+/// shipped gate's 2 mm particles 3.64 of its 1 mm cells, no warning; 4 mm particles against cells half as wide, 58.2,
+/// over the bound of 30, and both `check` and `run` warn, naming the solid (docs/CORRECTIONS.md "The structure's mesh
+/// against the fluid's particles": that gate gains 0.106 of its budget with WCSPH).
+#[test]
+fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
+    let gate = root().join("scenes/elastic_gate.toml");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", gate.to_str().unwrap(), "--json"];
+        for set in extra {
+            args.extend_from_slice(&["--set", set]);
+        }
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let shipped = check(&[]);
+    let ratio = shipped["particle_to_cell_mass"]["gate"].as_f64().unwrap();
+    assert!((ratio - 4.0 / 1.1).abs() < 1e-9, "{shipped}");
+    assert_eq!(shipped["warnings"], serde_json::json!([]));
+    let fine = ["fluid.spacing=0.004", "solid[0].divisions=[10,158]"];
+    let doc = check(&fine);
+    let ratio = doc["particle_to_cell_mass"]["gate"].as_f64().unwrap();
+    assert!((ratio - 64.0 / 1.1).abs() < 1e-9, "{doc}");
+    let warnings = doc["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{doc}");
+    assert!(
+        warnings[0].as_str().unwrap().contains("58 cells of solid `gate`"),
+        "{doc}"
+    );
+    let dir = scratch("heavy-particle");
+    let out = dir.join("out");
+    let mut args = vec![
+        "run",
+        "scenes/elastic_gate.toml",
+        "--in-process",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    for set in fine
+        .iter()
+        .chain(&["run.end_time=0.0005", "run.output_interval=0.0005"])
+    {
+        args.extend_from_slice(&["--set", set]);
+    }
+    let run = run_ok(&args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("cosim: warning: a fluid particle weighs 58 cells of solid `gate`"),
+        "{stderr}"
+    );
+}
+
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
 /// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]

@@ -13,6 +13,7 @@
 
 mod grid;
 mod load;
+mod mass_ratio;
 mod overrides;
 mod schema;
 mod sensors;
@@ -20,6 +21,7 @@ pub mod sizing;
 mod validate;
 
 pub use load::{load, parse, LoadedScene, SceneError};
+pub use mass_ratio::HEAVY_PARTICLE;
 pub use schema::{
     Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf,
     EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec,
