@@ -8,6 +8,7 @@ use cosim_proto::scene::{ContactAlgorithm as ContactChoice, Scene};
 
 use crate::contact::{self, ContactAlgorithm};
 use crate::contact_step;
+use crate::load_spread::LoadSpread;
 use crate::relaxation::{self, Relaxation};
 
 /// What one contact pass did, for `summary.json` `contact_stats` and the frames.
@@ -59,6 +60,8 @@ pub struct Interface {
     faces: bool,
     /// The impulse owed to the structure's nodes and not yet given (`contact.reaction_relaxation`).
     relaxation: Relaxation,
+    /// The structure's share spread along its surface (`contact.load_spread`).
+    spread: LoadSpread,
 }
 
 impl Interface {
@@ -130,6 +133,7 @@ impl Interface {
             recorded: false,
             faces: scene.contact.algorithm == ContactChoice::ParticleParticle,
             relaxation,
+            spread: LoadSpread::new(scene.contact.load_spread * dx),
         })
     }
 
@@ -253,8 +257,11 @@ impl Interface {
         stats.angular_momentum_change = ang;
         let mut node_impulse = node_impulse;
         let change = self.relaxation.give(&mut node_impulse, &self.fixed, dt);
-        for ((v, c), m) in nv.iter_mut().zip(&change).zip(&self.masses) {
-            if *c != [0.0; 2] {
+        // What the structure receives now, spread along its surface where the scene asks (load_spread.rs).
+        let spread = self.spread.apply(&self.segments, &nx, &self.fixed, &mut node_impulse);
+        for (((v, c), s), m) in nv.iter_mut().zip(&change).zip(&spread).zip(&self.masses) {
+            let c = [c[0] + s[0], c[1] + s[1]];
+            if c != [0.0; 2] {
                 *v = [v[0] + c[0] / m, v[1] + c[1] / m];
             }
         }

@@ -12,6 +12,7 @@ pub mod coordinator;
 pub mod energy_balance;
 pub mod interface;
 pub mod link;
+pub mod load_spread;
 pub mod output;
 pub mod probes;
 pub mod recorder;

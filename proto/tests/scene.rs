@@ -166,6 +166,28 @@ fn ppe_tolerance_is_for_isph_in_its_range_and_defaults_to_1e_6() {
     );
 }
 
+/// `contact.load_spread` (fluid spacings): 0 by default and then not written to the resolved scene; in [0, 4]; a
+/// value outside is refused in one line naming the key.
+#[test]
+fn load_spread_defaults_to_zero_in_its_range() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("g.toml", &text, &[]).unwrap();
+    assert_eq!(s.contact.load_spread, 0.0);
+    assert!(!s.to_toml().contains("load_spread"));
+    let s = parse("g.toml", &text, &["contact.load_spread=2".into()]).unwrap();
+    assert_eq!(s.contact.load_spread, 2.0);
+    assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    for bad in ["4.5", "-0.5", "nan", "inf"] {
+        let e = err(&text, &[&format!("contact.load_spread={bad}")]);
+        assert!(
+            e.starts_with("f.toml: contact.load_spread: must be in [0, 4] fluid spacings"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
 #[test]
 fn frame_interval_is_a_whole_multiple_of_the_output_interval() {
     let s = parse("f.toml", SCENE, &[]).unwrap();

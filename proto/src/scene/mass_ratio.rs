@@ -53,7 +53,8 @@ impl Scene {
                     "a fluid particle weighs {ratio:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
-                     the solid's divisions or refine fluid.spacing (docs/CORRECTIONS.md)"
+                     the solid's divisions, refine fluid.spacing or spread the load (contact.load_spread = 2; \
+                     docs/CORRECTIONS.md)"
                 )
             })
             .collect()

@@ -225,6 +225,11 @@ impl Scene {
             || "contact.sweeps".into(),
             || "must be at least 1".into(),
         )?;
+        check(
+            self.contact.load_spread.is_finite() && (0.0..=4.0).contains(&self.contact.load_spread),
+            || "contact.load_spread".into(),
+            || format!("must be in [0, 4] fluid spacings, got {}", self.contact.load_spread),
+        )?;
         if let Some(w) = self.contact.reaction_relaxation {
             check(
                 w > 0.0 && w <= 1.0,
