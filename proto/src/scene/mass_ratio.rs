@@ -65,43 +65,29 @@ impl Scene {
 mod tests {
     use crate::scene::parse;
 
-    const GATE: &str = r#"
-version = 1
-[run]
-name = "g"
-end_time = 0.1
-output_interval = 0.01
-[fluid]
-spacing = 0.004
-density = 1000.0
-[[fluid.block]]
-min = [0.0, 0.0]
-max = [0.1, 0.14]
-[[solid]]
-name = "gate"
-min = [0.1, 0.0]
-max = [0.105, 0.079]
-divisions = [5, 79]
-material = { model = "neo_hookean", density = 1100.0, youngs_modulus = 12.0e6, poisson_ratio = 0.4 }
-"#;
-
-    /// ρ Δx² / (ρ_s w h / (nx ny)): the gate's 1 mm cells against 4 mm particles, 16 / 1.1 = 14.55; halving the
-    /// cells quadruples it (58.2, over the bound: one warning naming the solid).
+    /// The shipped gate at Δx = 4 mm: ρ Δx² / (ρ_s w h / (nx ny)) = 16 / 1.1 = 14.55 against its 1 mm cells; halving
+    /// the cells quadruples it (58.2, over the bound: one warning naming the solid); no contact, no ratio.
     #[test]
     fn the_ratio_is_the_particle_over_a_cell_and_warns_above_the_bound() {
-        let scene = parse("g.toml", GATE, &[]).unwrap();
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let gate = |more: &[&str]| {
+            let mut sets = vec!["fluid.spacing=0.004".to_string()];
+            sets.extend(more.iter().map(|s| s.to_string()));
+            parse("g.toml", &text, &sets).unwrap()
+        };
+        let scene = gate(&[]);
         let r = scene.particle_to_cell_mass();
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].0, "gate");
         assert!((r[0].1 - 16.0 / 1.1).abs() < 1e-9, "{r:?}");
         assert!(scene.heavy_particle_warnings().is_empty());
-        let fine = parse("g.toml", &GATE.replace("[5, 79]", "[10, 158]"), &[]).unwrap();
+        let fine = gate(&["solid[0].divisions=[10,158]"]);
         let r = fine.particle_to_cell_mass();
         assert!((r[0].1 - 64.0 / 1.1).abs() < 1e-9, "{r:?}");
         let w = fine.heavy_particle_warnings();
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
-        let none = parse("g.toml", GATE, &["contact.algorithm=\"none\"".to_string()]).unwrap();
-        assert!(none.particle_to_cell_mass().is_empty());
+        assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
     }
 }
