@@ -47,6 +47,10 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     // WCSPH + particle_particle: the contact shortens the coupling step as the run goes (contact_step.rs).
     let contact_bound = coupled && contact_broker::contact_step::applies(s);
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
+    let mut warnings = s.heavy_particle_warnings();
+    if let (true, Some(d), Some(k)) = (coupled, dt_fem, substeps) {
+        warnings.extend(s.long_coupling_step_warning(dt, d, k));
+    }
     let samples = s.run.sample_count();
     let frames = s.run.frame_count();
     if args.json {
@@ -71,7 +75,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
                 .into_iter()
                 .map(|(name, r)| (name.to_string(), serde_json::json!(r)))
                 .collect::<serde_json::Map<_, _>>(),
-            "warnings": s.heavy_particle_warnings(),
+            "warnings": warnings,
             "frames": frames,
             "samples": samples,
             "probes": s.probes.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
@@ -163,7 +167,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     for (name, ratio) in s.particle_to_cell_mass() {
         println!("  contact: a fluid particle weighs {ratio:.1} cells of solid {name}");
     }
-    for w in s.heavy_particle_warnings() {
+    for w in &warnings {
         println!("  warning: {w}");
     }
     if contact_bound {

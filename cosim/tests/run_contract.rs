@@ -294,6 +294,35 @@ fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
     );
 }
 
+/// `cosim check` warns where, with ISPH, a coupling step spans many of the structure's FE steps against a mesh that a
+/// particle outweighs: the shipped gate left at the default `coupling.max_dt` (1e-3: ISPH's own step, 76 FE steps),
+/// not at its own 1e-4 (25), nor the hydrostatic plate (78 FE steps, a particle of 1.5 cells), nor WCSPH.
+#[test]
+fn check_warns_of_an_isph_coupling_step_spanning_many_fe_steps() {
+    let warnings = |scene: &str, extra: &[&str]| {
+        let path = root().join(scene);
+        let mut args = vec!["check", path.to_str().unwrap(), "--json"];
+        for set in extra {
+            args.extend_from_slice(&["--set", set]);
+        }
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        doc["warnings"].as_array().unwrap().clone()
+    };
+    let isph = "fluid.solver=isph";
+    let w = warnings("scenes/elastic_gate.toml", &[isph, "coupling.max_dt=1e-3"]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    let w = w[0].as_str().unwrap();
+    assert!(
+        w.contains("spans 76 FE steps") && w.contains("try coupling.max_dt = 1e-4"),
+        "{w}"
+    );
+    assert!(warnings("scenes/elastic_gate.toml", &[isph]).is_empty());
+    assert!(warnings("scenes/elastic_gate.toml", &["coupling.max_dt=1e-3"]).is_empty());
+    assert!(warnings("scenes/hydrostatic_plate.toml", &[isph]).is_empty());
+}
+
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
 /// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]

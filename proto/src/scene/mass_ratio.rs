@@ -8,11 +8,20 @@
 //! ratio alone, 0.0015 at 14.5 (Δx = 2 or 4 mm), 0.019 at 28 and 0.106 at 58; with ISPH it also grows with the
 //! coupling step (at `coupling.max_dt` 1e-4: 0.009 at 4.4, 0.053 at 14.5, 0.44 at 58).
 
-use super::schema::{ContactAlgorithm, Scene, SolidSpec};
+use super::schema::{ContactAlgorithm, FluidSolver, Scene, SolidSpec};
 
 /// The ratio above which `cosim check` and `cosim run` warn: between the gate's 28 (a gain of 0.019 with WCSPH) and
 /// 58 (0.106).
 pub const HEAVY_PARTICLE: f64 = 30.0;
+
+/// ISPH coupled to a structure: `cosim check` warns where a coupling step spans at least this many of the structure's
+/// FE steps and a fluid particle weighs at least [`LONG_STEP_RATIO`] cells. On the gate 24 FE steps kept every such
+/// case under the run's energy warning (0.018–0.093 of the budget) and 48 none (0.099–0.44); the hydrostatic plate
+/// spans 78 with a particle of 1.5 cells and keeps its energy.
+pub const LONG_COUPLING_STEP: u64 = 32;
+
+/// See [`LONG_COUPLING_STEP`]: the shipped gate's 3.6 is above it, the plate's 1.5 below.
+pub const LONG_STEP_RATIO: f64 = 3.0;
 
 impl SolidSpec {
     /// The mass of one cell of the mesh grid per unit depth [kg/m]: ρ_s times the cell's area (one quad4 element, two
@@ -59,6 +68,26 @@ impl Scene {
             })
             .collect()
     }
+
+    /// With ISPH, a coupling step of `coupling_dt` spanning `fem_steps` FE steps of `fem_dt` each: a warning where it
+    /// spans at least [`LONG_COUPLING_STEP`] of them against a solid whose cells a particle outweighs
+    /// [`LONG_STEP_RATIO`] times, naming a `coupling.max_dt` of 24 FE steps.
+    pub fn long_coupling_step_warning(&self, coupling_dt: f64, fem_dt: f64, fem_steps: u64) -> Option<String> {
+        let isph = self.fluid.as_ref()?.solver == FluidSolver::Isph;
+        let (name, ratio) = self
+            .particle_to_cell_mass()
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        (isph && ratio >= LONG_STEP_RATIO && fem_steps >= LONG_COUPLING_STEP).then(|| {
+            format!(
+                "with ISPH the coupling step ({coupling_dt:.2e} s) spans {fem_steps} FE steps of the structure, and a \
+                 fluid particle weighs {ratio:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
+                 step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
+                 free, made the 4 mm gate unstable); try coupling.max_dt = {:.0e} (docs/CORRECTIONS.md)",
+                24.0 * fem_dt
+            )
+        })
+    }
 }
 
 #[cfg(test)]
@@ -89,5 +118,14 @@ mod tests {
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
         assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
+        // The coupling step's length in FE steps: with ISPH only, from 32 FE steps, and naming 24 of them.
+        let isph = gate(&["fluid.solver=\"isph\""]);
+        let w = isph.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).unwrap();
+        assert!(
+            w.contains("spans 151 FE steps") && w.contains("coupling.max_dt = 1e-4"),
+            "{w}"
+        );
+        assert!(isph.long_coupling_step_warning(1e-4, 4.16e-6, 25).is_none());
+        assert!(scene.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).is_none());
     }
 }
