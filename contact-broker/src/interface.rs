@@ -256,12 +256,16 @@ impl Interface {
         stats.linear_momentum_change = lin;
         stats.angular_momentum_change = ang;
         let mut node_impulse = node_impulse;
-        let change = self.relaxation.give(&mut node_impulse, &self.fixed, dt);
+        let mut change = self.relaxation.give(&mut node_impulse, &self.fixed, dt);
         // What the structure receives now, spread along its surface where the scene asks (load_spread.rs).
-        let spread = self.spread.apply(&self.segments, &nx, &self.fixed, &mut node_impulse);
-        for (((v, c), s), m) in nv.iter_mut().zip(&change).zip(&spread).zip(&self.masses) {
-            let c = [c[0] + s[0], c[1] + s[1]];
-            if c != [0.0; 2] {
+        if self.spread.active() {
+            let spread = self.spread.apply(&self.segments, &nx, &self.fixed, &mut node_impulse);
+            for (c, s) in change.iter_mut().zip(&spread) {
+                *c = [c[0] + s[0], c[1] + s[1]];
+            }
+        }
+        for ((v, c), m) in nv.iter_mut().zip(&change).zip(&self.masses) {
+            if *c != [0.0; 2] {
                 *v = [v[0] + c[0] / m, v[1] + c[1] / m];
             }
         }

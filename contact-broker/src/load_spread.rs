@@ -18,8 +18,8 @@ use crate::contact::Segment;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LoadSpread {
     radius: f64,
-    /// Per node, its neighbours along the segments with the segment's index (scratch, rebuilt per pass).
-    adjacent: Vec<Vec<(usize, usize)>>,
+    /// Per node, its neighbours along the segments: built at the first pass (an interface's segments do not change).
+    adjacent: Vec<Vec<usize>>,
 }
 
 impl LoadSpread {
@@ -36,9 +36,9 @@ impl LoadSpread {
         self.radius > 0.0
     }
 
-    /// Replaces `impulse` (one per interface node, the nodes at `x`, joined by `segments`) by its spread, and returns
-    /// per node the spread less the impulse it had (to add to the node's velocity times its mass). Nothing changes
-    /// where [`LoadSpread::active`] is false.
+    /// Replaces `impulse` (one per interface node, the nodes at `x`, joined by `segments`, the same segments at every
+    /// call) by its spread, and returns per node the spread less the impulse it had (to add to the node's velocity
+    /// times its mass). Nothing changes where [`LoadSpread::active`] is false.
     pub fn apply(
         &mut self,
         segments: &[Segment],
@@ -51,15 +51,11 @@ impl LoadSpread {
         if !self.active() || n == 0 {
             return change;
         }
-        self.adjacent.resize_with(n, Vec::new);
-        self.adjacent.truncate(n);
-        for a in &mut self.adjacent {
-            a.clear();
-        }
-        for (k, s) in segments.iter().enumerate() {
-            if s.a < n && s.b < n && s.a != s.b {
-                self.adjacent[s.a].push((s.b, k));
-                self.adjacent[s.b].push((s.a, k));
+        if self.adjacent.len() != n {
+            self.adjacent = vec![Vec::new(); n];
+            for s in segments.iter().filter(|s| s.a < n && s.b < n && s.a != s.b) {
+                self.adjacent[s.a].push(s.b);
+                self.adjacent[s.b].push(s.a);
             }
         }
         let length = |a: usize, b: usize| {
@@ -90,7 +86,7 @@ impl LoadSpread {
             {
                 dist[at].2 = true;
                 let (node, d) = (dist[at].0, dist[at].1);
-                for &(next, _) in &self.adjacent[node] {
+                for &next in &self.adjacent[node] {
                     let dn = d + length(node, next);
                     if dn >= self.radius {
                         continue;

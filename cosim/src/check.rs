@@ -47,6 +47,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     // WCSPH + particle_particle: the contact shortens the coupling step as the run goes (contact_step.rs).
     let contact_bound = coupled && contact_broker::contact_step::applies(s);
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
+    let ratios = s.particle_to_cell_mass();
     let mut warnings = s.heavy_particle_warnings();
     if let (true, Some(d), Some(k)) = (coupled, dt_fem, substeps) {
         warnings.extend(s.long_coupling_step_warning(dt, d, k));
@@ -70,10 +71,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
             // A fluid particle's mass over one mesh cell's, per solid (proto::scene::mass_ratio).
-            "particle_to_cell_mass": s
-                .particle_to_cell_mass()
-                .into_iter()
-                .map(|(name, r)| (name.to_string(), serde_json::json!(r)))
+            "particle_to_cell_mass": ratios
+                .iter()
+                .map(|&(name, r)| (name.to_string(), serde_json::json!(r)))
                 .collect::<serde_json::Map<_, _>>(),
             "warnings": warnings,
             "frames": frames,
@@ -164,7 +164,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         ),
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
     }
-    for (name, ratio) in s.particle_to_cell_mass() {
+    for (name, ratio) in &ratios {
         println!("  contact: a fluid particle weighs {ratio:.1} cells of solid {name}");
     }
     for w in &warnings {

@@ -218,20 +218,24 @@ fn check_prints_what_would_run() {
     assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
 }
 
+/// `cosim check SCENE --json --set …` from the workspace root, its document (fails the test unless it succeeds).
+fn check_json(scene: &str, sets: &[&str]) -> serde_json::Value {
+    let path = root().join(scene);
+    let mut args = vec!["check", path.to_str().unwrap(), "--json"];
+    for set in sets {
+        args.extend_from_slice(&["--set", set]);
+    }
+    let out = cosim_run(&args, Duration::from_secs(30));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 /// `cosim check` says where the coupling step will be shorter than its estimate: WCSPH with `particle_particle`,
 /// whose stiff force bounds it as the run goes (contact-broker/src/contact_step.rs), not `particle_element` nor ISPH.
 #[test]
 fn check_says_when_the_contact_bounds_the_step() {
-    let gate = root().join("scenes/elastic_gate.toml");
-    let bounded = |extra: &[&str]| {
-        let mut args = vec!["check", gate.to_str().unwrap(), "--json"];
-        for set in extra {
-            args.extend_from_slice(&["--set", set]);
-        }
-        let out = cosim_run(&args, Duration::from_secs(30));
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["coupling_dt_bounded_by_contact"].clone()
-    };
+    let bounded =
+        |extra: &[&str]| check_json("scenes/elastic_gate.toml", extra)["coupling_dt_bounded_by_contact"].clone();
     assert_eq!(bounded(&[]), false);
     assert_eq!(bounded(&["contact.algorithm=particle_particle"]), true);
     assert_eq!(
@@ -246,16 +250,7 @@ fn check_says_when_the_contact_bounds_the_step() {
 /// against the fluid's particles": that gate gains 0.106 of its budget with WCSPH).
 #[test]
 fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
-    let gate = root().join("scenes/elastic_gate.toml");
-    let check = |extra: &[&str]| {
-        let mut args = vec!["check", gate.to_str().unwrap(), "--json"];
-        for set in extra {
-            args.extend_from_slice(&["--set", set]);
-        }
-        let out = cosim_run(&args, Duration::from_secs(30));
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
-    };
+    let check = |extra: &[&str]| check_json("scenes/elastic_gate.toml", extra);
     let shipped = check(&[]);
     let ratio = shipped["particle_to_cell_mass"]["gate"].as_f64().unwrap();
     assert!((ratio - 4.0 / 1.1).abs() < 1e-9, "{shipped}");
@@ -299,17 +294,7 @@ fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
 /// not at its own 1e-4 (25), nor the hydrostatic plate (78 FE steps, a particle of 1.5 cells), nor WCSPH.
 #[test]
 fn check_warns_of_an_isph_coupling_step_spanning_many_fe_steps() {
-    let warnings = |scene: &str, extra: &[&str]| {
-        let path = root().join(scene);
-        let mut args = vec!["check", path.to_str().unwrap(), "--json"];
-        for set in extra {
-            args.extend_from_slice(&["--set", set]);
-        }
-        let out = cosim_run(&args, Duration::from_secs(30));
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        doc["warnings"].as_array().unwrap().clone()
-    };
+    let warnings = |scene: &str, extra: &[&str]| check_json(scene, extra)["warnings"].as_array().unwrap().clone();
     let isph = "fluid.solver=isph";
     let w = warnings("scenes/elastic_gate.toml", &[isph, "coupling.max_dt=1e-3"]);
     assert_eq!(w.len(), 1, "{w:?}");

@@ -21,7 +21,6 @@ pub mod sizing;
 mod validate;
 
 pub use load::{load, parse, LoadedScene, SceneError};
-pub use mass_ratio::HEAVY_PARTICLE;
 pub use schema::{
     Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf,
     EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec,
