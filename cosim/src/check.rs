@@ -130,6 +130,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             solid.fixed.len(),
             solid.damping
         );
+        if solid.mesh_damping > 0.0 {
+            println!(
+                "    mesh damping: stiffness-proportional, a ratio of {} at the mesh's highest mode",
+                solid.mesh_damping
+            );
+        }
     }
     match (&s.fluid, &fluid) {
         (Some(f), Some(core)) => println!(

@@ -21,6 +21,9 @@ pub struct SolidModel {
     pub density: f64,
     /// Mass-proportional damping coefficient [1/s].
     pub damping: f64,
+    /// Stiffness-proportional damping time β [s]: the internal forces are taken at x + β v
+    /// (`solver::central_difference`); `mesh_damping` × the shortest L_e / c_d of the reference mesh.
+    pub stiffness_damping: f64,
     /// Element type.
     pub element: ElementKind,
     /// Its global node ids.
@@ -108,6 +111,12 @@ impl FemModel {
                 spec.damping
             )));
         }
+        if !(spec.mesh_damping.is_finite() && (0.0..1.0).contains(&spec.mesh_damping)) {
+            return Err(invalid(format!(
+                "mesh_damping must be in [0, 1), got {}",
+                spec.mesh_damping
+            )));
+        }
         if spec.divisions.contains(&0) {
             return Err(invalid(format!(
                 "divisions must be at least 1, got {:?}",
@@ -146,21 +155,36 @@ impl FemModel {
             self.element_solid.push(index);
         }
         self.boundary.extend_from_slice(&mesh.boundary);
-        self.solids.push(SolidModel {
+        let mut solid = SolidModel {
             name: spec.name.clone(),
             material,
             density: m.density,
             damping: spec.damping,
+            stiffness_damping: 0.0,
             element: spec.element,
             nodes: first..self.reference.len(),
             elements: first_element..self.elements.len(),
-        });
+        };
+        if spec.mesh_damping > 0.0 {
+            // ζ at the mesh's highest mode, ω_max ≈ 2 c_d / L_e of its shortest element: β = 2ζ / ω_max.
+            let shortest = self.elements[solid.elements.clone()]
+                .iter()
+                .map(|e| e.characteristic_length(&self.reference))
+                .fold(f64::INFINITY, f64::min);
+            solid.stiffness_damping = spec.mesh_damping * shortest / solid.wave_speed();
+        }
+        self.solids.push(solid);
         Ok(())
     }
 
     /// Solids in scene order.
     pub fn solids(&self) -> &[SolidModel] {
         &self.solids
+    }
+
+    /// Whether any solid has stiffness-proportional damping (`mesh_damping`).
+    pub fn stiffness_damped(&self) -> bool {
+        self.solids.iter().any(|s| s.stiffness_damping > 0.0)
     }
 
     /// Reference node positions `X`.

@@ -84,6 +84,8 @@ pub struct FemScratch {
     pub element_forces: Vec<ElementForces>,
     /// Assembled internal forces per node.
     pub internal: Vec<[f64; 2]>,
+    /// The positions `x + β v` the internal forces of a stiffness-damped solid are taken at (empty without one).
+    pub damped_positions: Vec<[f64; 2]>,
 }
 
 impl FemScratch {
@@ -92,6 +94,7 @@ impl FemScratch {
         Self {
             element_forces: vec![[[0.0; 2]; 4]; model.elements().len()],
             internal: vec![[0.0; 2]; model.node_count()],
+            damped_positions: Vec::new(),
         }
     }
 }

@@ -188,6 +188,30 @@ fn load_spread_defaults_to_zero_in_its_range() {
     }
 }
 
+/// `solid[i].mesh_damping` (the damping ratio of the mesh's highest mode): 0 by default and then not written to the
+/// resolved scene; in [0, 1); a bad value is refused with one line naming the key.
+#[test]
+fn mesh_damping_defaults_to_zero_in_its_range() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("g.toml", &text, &[]).unwrap();
+    assert_eq!(s.solids[0].mesh_damping, 0.0);
+    assert!(!s.to_toml().contains("mesh_damping"));
+    let s = parse("g.toml", &text, &["solid[0].mesh_damping=0.25".into()]).unwrap();
+    assert_eq!(s.solids[0].mesh_damping, 0.25);
+    assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    for bad in ["1", "1.5", "-0.1", "nan", "inf"] {
+        let e = err(&text, &[&format!("solid[0].mesh_damping={bad}")]);
+        assert!(
+            e.starts_with(
+                "f.toml: solid[0].mesh_damping: must be in [0, 1) (the damping ratio of the mesh's highest mode)"
+            ),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
 #[test]
 fn frame_interval_is_a_whole_multiple_of_the_output_interval() {
     let s = parse("f.toml", SCENE, &[]).unwrap();

@@ -6,6 +6,12 @@
 //!
 //! This is the central difference of Eq. (3), Long et al. 2016 (`v^{n+½} = v^{n−½} + Δt a^n` once the two
 //! half kicks are merged). Clamped nodes keep `x = X`, `v = 0`, `a = 0`.
+//!
+//! Stiffness-proportional (Rayleigh β) damping, where a solid has it (`mesh_damping`): `f_int` is taken at
+//! `x + β v` (with `v^{n+½}` in a step, as the mass-proportional term), which is `f_int(x) + β K(x) v + O(β²)`, the
+//! damping force `β K v` of any element and material without forming `K` (Belytschko, Liu & Moran, Nonlinear Finite
+//! Elements, §6.2.4: a mode of angular frequency ω is damped by the ratio `β ω / 2`). Internal forces sum to zero
+//! at any positions, so the damping keeps the linear momentum.
 
 use crate::element::ElementFailure;
 use crate::model::FemModel;
@@ -31,6 +37,30 @@ pub fn accelerations(model: &FemModel, v: &[[f64; 2]], scratch: &FemScratch, a: 
     }
 }
 
+/// Fills `scratch.internal` with the internal forces of positions `x` and velocities `v`: `f_int(x)`, or
+/// `f_int(x + β v)` for the nodes of a solid with stiffness-proportional damping β (module docs).
+fn damped_internal_forces(
+    model: &FemModel,
+    x: &[[f64; 2]],
+    v: &[[f64; 2]],
+    scratch: &mut FemScratch,
+    parallel_min_elements: usize,
+) -> Result<(), (usize, ElementFailure)> {
+    if !model.stiffness_damped() {
+        return internal_forces(model, x, scratch, parallel_min_elements);
+    }
+    let mut shifted = std::mem::take(&mut scratch.damped_positions);
+    shifted.clear();
+    let solids = model.solids();
+    shifted.extend(x.iter().zip(v).zip(model.node_solid()).map(|((x, v), &s)| {
+        let beta = solids[s as usize].stiffness_damping;
+        [x[0] + beta * v[0], x[1] + beta * v[1]]
+    }));
+    let result = internal_forces(model, &shifted, scratch, parallel_min_elements);
+    scratch.damped_positions = shifted;
+    result
+}
+
 /// Recomputes `state.a` from `state.x` and `state.v`.
 pub fn refresh_accelerations(
     model: &FemModel,
@@ -38,7 +68,7 @@ pub fn refresh_accelerations(
     scratch: &mut FemScratch,
     parallel_min_elements: usize,
 ) -> Result<(), (usize, ElementFailure)> {
-    internal_forces(model, &state.x, scratch, parallel_min_elements)?;
+    damped_internal_forces(model, &state.x, &state.v, scratch, parallel_min_elements)?;
     accelerations(model, &state.v, scratch, &mut state.a);
     Ok(())
 }
@@ -69,8 +99,8 @@ pub fn step(
         x[0] += dt * v[0];
         x[1] += dt * v[1];
     }
-    internal_forces(model, &state.x, scratch, parallel_min_elements)?;
-    // The damping force uses v^{n+½}, the latest velocity known before the closing kick.
+    // The damping forces use v^{n+½}, the latest velocity known before the closing kick.
+    damped_internal_forces(model, &state.x, &state.v, scratch, parallel_min_elements)?;
     accelerations(model, &state.v, scratch, &mut state.a);
     for (v, a) in state.v.iter_mut().zip(&state.a) {
         v[0] += half * a[0];

@@ -7,6 +7,9 @@
 //! ν = 0–0.49), the largest stable `cfl` is 1.00–1.41 for quads (1.00 for very elongated cells) and 0.943–1.2 for
 //! the checkerboard triangles (0.943 for cells of aspect 5:1 and more): the default `cfl = 0.9` is stable for both,
 //! while `cfl` above 0.94 can blow up elongated triangles (reported as [`crate::FemError::Unstable`]).
+//!
+//! With stiffness-proportional damping β an element's step is shortened by `√(1 + ζ²) − ζ`, ζ = β c_d / L_e its
+//! damping ratio at ω = 2 c_d / L_e (Belytschko, Liu & Moran, Nonlinear Finite Elements, Eq. 6.2.32).
 
 use crate::model::FemModel;
 
@@ -21,7 +24,14 @@ pub fn stable_dt(model: &FemModel, x: &[[f64; 2]], cfl: f64) -> Result<f64, (usi
             if !(l > 0.0 && l.is_finite()) {
                 return Err((e, l));
             }
-            dt = dt.min(cfl * l / c);
+            let undamped = cfl * l / c;
+            let beta = solid.stiffness_damping;
+            dt = dt.min(if beta > 0.0 {
+                let zeta = beta * c / l;
+                undamped * ((1.0 + zeta * zeta).sqrt() - zeta)
+            } else {
+                undamped
+            });
         }
     }
     Ok(dt)

@@ -62,8 +62,9 @@ impl Scene {
                     "a fluid particle weighs {ratio:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
-                     the solid's divisions, refine fluid.spacing or spread the load (contact.load_spread = 2; \
-                     docs/CORRECTIONS.md)"
+                     the solid's divisions, refine fluid.spacing, damp the ringing ({}.mesh_damping = 0.25) or spread \
+                     the load (contact.load_spread = 2; docs/CORRECTIONS.md)",
+                    self.solid_key(name)
                 )
             })
             .collect()
@@ -83,10 +84,18 @@ impl Scene {
                 "with ISPH the coupling step ({coupling_dt:.2e} s) spans {fem_steps} FE steps of the structure, and a \
                  fluid particle weighs {ratio:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
                  step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
-                 free, made the 4 mm gate unstable); try coupling.max_dt = {:.0e} (docs/CORRECTIONS.md)",
-                24.0 * fem_dt
+                 free, made the 4 mm gate unstable); try coupling.max_dt = {:.0e}, or damp the structure's ringing \
+                 ({}.mesh_damping = 0.25: the 4 mm gate then ends at ISPH's own step; docs/CORRECTIONS.md)",
+                24.0 * fem_dt,
+                self.solid_key(name)
             )
         })
+    }
+
+    /// `solid[i]`, the key of the solid named `name`.
+    fn solid_key(&self, name: &str) -> String {
+        let i = self.solids.iter().position(|s| s.name == name).unwrap_or(0);
+        format!("solid[{i}]")
     }
 }
 

@@ -475,6 +475,16 @@ impl Scene {
             || key("damping"),
             || format!("must be zero or positive, got {}", solid.damping),
         )?;
+        check(
+            solid.mesh_damping.is_finite() && (0.0..1.0).contains(&solid.mesh_damping),
+            || key("mesh_damping"),
+            || {
+                format!(
+                    "must be in [0, 1) (the damping ratio of the mesh's highest mode), got {}",
+                    solid.mesh_damping
+                )
+            },
+        )?;
         for (f, b) in solid.fixed.iter().enumerate() {
             check(
                 b.min.iter().chain(&b.max).all(|v| v.is_finite()),

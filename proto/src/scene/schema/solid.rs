@@ -63,6 +63,17 @@ pub struct SolidSpec {
     /// Mass-proportional damping coefficient [1/s] (force −c·m·v); 0 (default) is undamped.
     #[serde(default)]
     pub damping: f64,
+    /// Stiffness-proportional (Rayleigh β) damping given as the damping ratio ζ of the mesh's highest mode: the
+    /// internal forces are taken at x + β v with β = ζ · min_e L_e / c_d of the reference mesh, so a mode of angular
+    /// frequency ω is damped by the ratio β ω / 2 — ζ at the mesh's own scale (ω ≈ 2 c_d / L_e), a thousandth of it
+    /// or less for the bending modes a scene looks at (`fem-node/src/solver/central_difference.rs`). In [0, 1); 0
+    /// (default) is off.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub mesh_damping: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn default_element() -> ElementKind {
