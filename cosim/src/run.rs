@@ -172,6 +172,14 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                     h.mean, h.try_dt
                 );
             }
+            // A structure whose mesh rings under the contact's impulses (docs/CORRECTIONS.md "Damping the
+            // structure's mesh-scale ringing").
+            if let Some(i) = scene.scene.solids.iter().position(|s| s.mesh_damping == 0.0) {
+                eprintln!(
+                    "cosim: so is damping the structure's mesh-scale ringing, --set solid[{i}].mesh_damping=0.25 \
+                     (docs/CORRECTIONS.md)"
+                );
+            }
         }
         Ok(ExitCode::SUCCESS)
     } else {
