@@ -562,8 +562,15 @@ fn isph_gate(max_dt: &str, more: &[&str]) -> Outcome {
     let mut sets = gate(GATE_E, &["fluid.solver=isph", &format!("coupling.max_dt={max_dt}")]);
     sets.extend(more.iter().map(|s| s.to_string()));
     sets.push("probe[0]={name=\"structure\",kind=\"energy\",part=\"total\",of=\"structure\"}".into());
+    // Tests run side by side: one folder and run id per setting, the extra keys by their FNV-1a hash.
+    let tag = more
+        .iter()
+        .flat_map(|s| s.bytes().chain([0]))
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+        });
     run(
-        &format!("gate-isph-{}", max_dt.replace('-', "m")),
+        &format!("gate-isph-{}-{tag:016x}", max_dt.replace('-', "m")),
         "scenes/elastic_gate.toml",
         &sets,
     )
