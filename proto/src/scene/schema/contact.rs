@@ -54,12 +54,8 @@ pub struct ContactSpec {
     /// The structure's share of each contact impulse spread over the interface nodes within this many fluid
     /// spacings of its node, along the surface, with weights 1 − d/R (`contact-broker/src/load_spread.rs`); 0, the
     /// default, leaves it on the segment's nodes as the contact algorithm puts it. In [0, 4].
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "super::is_zero")]
     pub load_spread: f64,
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
 }
 
 fn default_algorithm() -> ContactAlgorithm {

@@ -75,7 +75,7 @@ pub struct FluidSpec {
     /// δ of the δ-SPH density diffusion in the continuity equation (Molteni & Colagrossi 2009, with the hydrostatic
     /// correction of Fourtakas et al. 2019; WCSPH only), in [0, 1]; 0, the default, disables it (0.1 is the usual
     /// value). Not written to `scene.toml` when 0.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "super::is_zero")]
     pub density_diffusion: f64,
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -117,10 +117,6 @@ fn default_xsph() -> f64 {
 
 fn default_fluid_cfl() -> f64 {
     1.0
-}
-
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
 }
 
 fn is_default_fluid_cfl(cfl: &f64) -> bool {

@@ -121,3 +121,8 @@ impl Scene {
         toml::to_string(self).expect("a validated scene serialises")
     }
 }
+
+/// A number key left at 0 is not written to the resolved scene (`skip_serializing_if`).
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}

@@ -68,12 +68,8 @@ pub struct SolidSpec {
     /// frequency ω is damped by the ratio β ω / 2 — ζ at the mesh's own scale (ω ≈ 2 c_d / L_e), a thousandth of it
     /// or less for the bending modes a scene looks at (`fem-node/src/solver/central_difference.rs`). In [0, 1); 0
     /// (default) is off.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "super::is_zero")]
     pub mesh_damping: f64,
-}
-
-fn is_zero(x: &f64) -> bool {
-    *x == 0.0
 }
 
 fn default_element() -> ElementKind {
