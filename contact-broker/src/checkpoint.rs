@@ -37,8 +37,9 @@ pub use broker_state::BrokerState;
 /// Version of the checkpoint folder's layout and of `broker.bin`. 2: the manifest holds each file's CRC-32; 3: the
 /// interface_load probes' impulse since the last sample (`BrokerState::load_log`); 4: the contact impulse owed to the
 /// structure (`BrokerState::owed`); 5: the contact's bound on the coupling step (`BrokerState::dt_contact`); 6: the
-/// run's energy balance (`Summary::energy_growth`).
-pub const FORMAT: u32 = 6;
+/// run's energy balance (`Summary::energy_growth`); 7: the structure's bound on the coupling step
+/// (`BrokerState::dt_structure`).
+pub const FORMAT: u32 = 7;
 /// The manifest's file name.
 pub const MANIFEST: &str = "checkpoint.json";
 const TAG: &str = "cosim-broker-checkpoint";

@@ -12,7 +12,7 @@ use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
-use cosim_proto::scene::LoadedScene;
+use cosim_proto::scene::{LoadedScene, STRUCTURE_COURANT_DEFAULT};
 use cosim_proto::sizing::Part;
 use cosim_proto::trace::Node;
 use fem_node::core::FemCore;
@@ -170,6 +170,16 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                     "cosim: a shorter coupling step is the first thing to try: this run's averaged {:.2e} s, e.g. \
                      --set coupling.max_dt={:.0e}",
                     h.mean, h.try_dt
+                );
+            }
+            // A structure whose surface moves a large part of h between two contact passes (docs/CORRECTIONS.md
+            // "The coupling step bounded by the structure's speed").
+            let c = scene.scene.coupling.structure_courant;
+            if !scene.scene.solids.is_empty() && scene.scene.fluid.is_some() {
+                let try_c = if c > 0.0 { 0.5 * c } else { STRUCTURE_COURANT_DEFAULT };
+                eprintln!(
+                    "cosim: so is a step bounded by the structure's speed, --set coupling.structure_courant={try_c} \
+                     (now {c})"
                 );
             }
             // A structure whose mesh rings under the contact's impulses (docs/CORRECTIONS.md "Damping the

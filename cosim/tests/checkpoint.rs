@@ -203,6 +203,14 @@ fn isph_restart_is_byte_identical() {
     gate_restart("checkpoint-isph", "isph", &[]);
 }
 
+/// ISPH at its own step (`coupling.max_dt = 1e-2`), where the structure's speed bounds the coupling step (525 steps
+/// to 0.1 s, 218 without the bound; `BrokerState::dt_structure`): the bound in force at the checkpoint holds on after
+/// the restart.
+#[test]
+fn isph_restart_with_the_structures_bound_on_the_step_is_byte_identical() {
+    gate_restart("checkpoint-isph-own-step", "isph", &["--set", "coupling.max_dt=1e-2"]);
+}
+
 /// ISPH with `particle_particle`: the contact impulse still owed to the gate's nodes at the checkpoint
 /// (`contact.reaction_relaxation`, `BrokerState::owed`) is saved and given on after the restart.
 #[test]

@@ -141,6 +141,35 @@ fn fluid_cfl_defaults_to_one_and_is_refused_above_one() {
 }
 
 #[test]
+fn structure_courant_defaults_to_its_constant_in_its_range() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("g.toml", &text, &[]).unwrap();
+    assert_eq!(
+        s.coupling.structure_courant,
+        cosim_proto::scene::STRUCTURE_COURANT_DEFAULT
+    );
+    assert_eq!(s.coupling.structure_courant, 0.05);
+    // At the default the resolved scene is written as before (checkpoints compare it line by line).
+    assert!(!s.to_toml().lines().any(|l| l.starts_with("structure_courant")));
+    for ok in ["0", "0.02", "1"] {
+        let s = parse("g.toml", &text, &[format!("coupling.structure_courant={ok}")]).unwrap();
+        assert_eq!(s.coupling.structure_courant, ok.parse::<f64>().unwrap());
+        assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    }
+    for bad in ["1.5", "-0.1", "nan", "inf"] {
+        let e = err(&text, &[&format!("coupling.structure_courant={bad}")]);
+        assert!(
+            e.starts_with(
+                "f.toml: coupling.structure_courant: must be in [0, 1] (0: no bound from the structure's speed)"
+            ),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
+#[test]
 fn ppe_tolerance_is_for_isph_in_its_range_and_defaults_to_1e_6() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/dam_break.toml");
     let text = std::fs::read_to_string(path).unwrap();

@@ -26,6 +26,9 @@ pub struct BrokerState {
     pub dt_fluid: f64,
     /// The longest step the contact allows from now on [s]; infinite where it sets no bound (`contact_step`).
     pub dt_contact: f64,
+    /// The longest next step the structure's speed allows [s]; infinite at rest or without the bound
+    /// (`coupling.structure_courant`).
+    pub dt_structure: f64,
     /// Contact corrections of the last step, still to be sent to the structure node.
     pub pending_fem: Vec<Correction>,
     /// … and to the fluid node.
@@ -86,6 +89,9 @@ impl BrokerState {
         })?;
         ensure(self.dt_contact > 0.0, || {
             format!("dt_contact = {} is not a positive step", self.dt_contact)
+        })?;
+        ensure(self.dt_structure > 0.0, || {
+            format!("dt_structure = {} is not a positive step", self.dt_structure)
         })?;
         if let Some(g) = &s.energy_growth {
             // A budget that is not positive would divide every later gain by zero or turn its sign.
@@ -272,6 +278,7 @@ component = "x"
             next_checkpoint: 2,
             dt_fluid: 1e-3,
             dt_contact: f64::INFINITY,
+            dt_structure: f64::INFINITY,
             pending_fem: vec![Correction {
                 id: 5,
                 dx: [0.0, 1e-4],
@@ -367,6 +374,8 @@ component = "x"
             assert_eq!(e, format!("dt_fluid = {dt} is not a positive step"));
             let e = refused(|s| s.dt_contact = dt);
             assert_eq!(e, format!("dt_contact = {dt} is not a positive step"));
+            let e = refused(|s| s.dt_structure = dt);
+            assert_eq!(e, format!("dt_structure = {dt} is not a positive step"));
         }
         let e = refused(|s| s.next_output = 2);
         assert!(

@@ -77,6 +77,7 @@ pub(super) fn save_if_due(
         next_checkpoint: schedule.next,
         dt_fluid: clock.dt_fluid,
         dt_contact: clock.dt_contact,
+        dt_structure: clock.dt_structure,
         pending_fem: contact.pending.fem.clone(),
         pending_sph: contact.pending.sph.clone(),
         roi: contact.roi,
@@ -126,7 +127,7 @@ pub(super) fn resume(
 ) -> anyhow::Result<()> {
     saved.check_nodes(summary.fem_nodes, summary.particles)?;
     (clock.t, clock.step, clock.next_output) = (saved.t, saved.step, saved.next_output);
-    (clock.dt_fluid, clock.dt_contact) = (saved.dt_fluid, saved.dt_contact);
+    (clock.dt_fluid, clock.dt_contact, clock.dt_structure) = (saved.dt_fluid, saved.dt_contact, saved.dt_structure);
     // From the time, not the saved index: the restart may ask for another interval.
     schedule.next = schedule
         .interval

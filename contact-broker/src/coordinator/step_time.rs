@@ -1,7 +1,7 @@
 //! The run's clock (`DESIGN.md` §3 step 1): how long each coupling step is, and the output times the steps land
 //! on.
 
-use cosim_proto::scene::Scene;
+use cosim_proto::scene::{ContactAlgorithm, Scene};
 
 use super::exchange::Round;
 use crate::summary::Summary;
@@ -22,6 +22,10 @@ pub(super) struct Clock {
     /// The longest step the contact passes so far allow [s] (infinite where none set a bound:
     /// [`crate::contact_step`]).
     pub dt_contact: f64,
+    /// The longest next step the structure's speed allows [s] ([`Clock::structure_bound`]; infinite at rest).
+    pub dt_structure: f64,
+    /// `coupling.structure_courant` · h: how far the structure's surface may move in one step [m] (0: no bound).
+    reach: f64,
     interval: f64,
     end: f64,
     max_dt: f64,
@@ -40,6 +44,20 @@ pub(super) struct Step {
     pub cap: f64,
 }
 
+/// How far the structure's surface may move in one coupling step [m]: `coupling.structure_courant` · h with the
+/// particle–element contact, which corrects at each step's end what the step made penetrate; 0 (no bound) otherwise.
+/// `particle_particle` corrects nothing: its force acts, and its step is bounded by the force's stiffness (WCSPH,
+/// [`crate::contact_step`]) or its reaction relaxed (ISPH); the ISPH + `particle_particle` gate bounded by the
+/// structure's speed took three times the steps and heated its mesh as much (docs/CORRECTIONS.md).
+fn structure_reach(scene: &Scene) -> f64 {
+    match (&scene.fluid, scene.contact.algorithm) {
+        (Some(f), ContactAlgorithm::ParticleElement) => {
+            scene.coupling.structure_courant * f.smoothing_ratio * f.spacing
+        }
+        _ => 0.0,
+    }
+}
+
 impl Clock {
     /// The clock at t = 0 of `scene`; `structure` says whether a structure node takes part, `dt_fluid` is the
     /// fluid's first stable step (infinite without a fluid).
@@ -50,6 +68,8 @@ impl Clock {
             next_output: 1,
             dt_fluid,
             dt_contact: f64::INFINITY,
+            dt_structure: f64::INFINITY,
+            reach: structure_reach(scene),
             interval: scene.run.output_interval,
             end: scene.run.end_time,
             max_dt: scene.coupling.max_dt,
@@ -67,13 +87,16 @@ impl Clock {
         self.t < self.end
     }
 
-    /// Fix the next coupling step: the fluid's stable step and the contact's, capped by the user and the next
-    /// output time. Without a structure there is nothing to couple: the fluid node sub-cycles at its own stable
+    /// Fix the next coupling step: the fluid's stable step, the contact's and the structure's, capped by the user and
+    /// the next output time. Without a structure there is nothing to couple: the fluid node sub-cycles at its own stable
     /// step.
     pub fn next_step(&mut self) -> Step {
         let target = (self.next_output as f64 * self.interval).min(self.end);
         let cap = if self.structure {
-            self.max_dt.min(self.dt_fluid).min(self.dt_contact)
+            self.max_dt
+                .min(self.dt_fluid)
+                .min(self.dt_contact)
+                .min(self.dt_structure)
         } else {
             self.max_dt
         };
@@ -114,11 +137,27 @@ impl Clock {
         }
     }
 
+    /// The next step from the interface nodes' velocities `v` at the end of the last one: at most
+    /// `coupling.structure_courant` · h / |v|_max, so that the surface moves at most that fraction of the fluid's
+    /// smoothing length between two contact passes. The contact corrects what the surface's motion over a step made
+    /// penetrate, in one pass at the step's end; a surface that moves a large part of h in a step (an ISPH step on
+    /// the elastic gate spans ~115 of its FE steps, and the gate's surface rings at the mesh's own frequencies) makes
+    /// corrections of that size, and the coupled energy grows (docs/CORRECTIONS.md "The coupling step bounded by the
+    /// structure's speed"). Not kept from step to step: the bound follows the structure.
+    fn structure_bound(&mut self, v: &[[f64; 2]]) {
+        if self.reach <= 0.0 {
+            return;
+        }
+        let speed = v.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+        self.dt_structure = if speed > 0.0 { self.reach / speed } else { f64::INFINITY };
+    }
+
     /// The nodes answered `step`: count their sub-steps, take the fluid's new stable step, and move on to the end
     /// of the step.
     pub fn advance(&mut self, step: &Step, round: &Round, summary: &mut Summary) {
         if let Some(state) = &round.fem {
             summary.fem_substeps += u64::from(state.substeps);
+            self.structure_bound(&state.v);
         }
         if let Some(state) = &round.sph {
             self.dt_fluid = state.dt_stable;
@@ -134,5 +173,61 @@ impl Clock {
         if step.target >= self.next_output as f64 * self.interval {
             self.next_output += 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use cosim_proto::messages::FemState;
+    use cosim_proto::scene::parse;
+
+    use super::*;
+
+    fn gate(sets: &[&str]) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        parse("gate.toml", &text, &sets).unwrap()
+    }
+
+    /// The next step after the structure answered with interface velocities `v`, on a clock whose fluid and user
+    /// allow 1 s.
+    fn step_after(scene: &Scene, v: Vec<[f64; 2]>) -> f64 {
+        let mut clock = Clock::new(scene, true, 1.0);
+        (clock.max_dt, clock.end, clock.interval) = (1.0, 100.0, 1000.0);
+        let first = clock.next_step();
+        let fem = FemState {
+            ids: Vec::new(),
+            x: vec![[0.0; 2]; v.len()],
+            v,
+            substeps: 1,
+            dt_stable: 1.0,
+            compute_seconds: 0.0,
+            snapshot: None,
+        };
+        let round = Round {
+            fem: Some(fem),
+            sph: None,
+        };
+        clock.advance(&first, &round, &mut Summary::failed("r", "in-process", String::new()));
+        clock.next_step().dt
+    }
+
+    #[test]
+    fn the_structures_speed_bounds_the_next_step_with_the_particle_element_contact() {
+        // h = 1.3 × 2 mm; the fastest node (3, 4) m/s moves 0.05 h in 0.05 h / 5 s.
+        let scene = gate(&[]);
+        let v = vec![[0.1, 0.0], [3.0, -4.0], [-1.0, 2.0]];
+        assert_eq!(step_after(&scene, v.clone()), 0.05 * (1.3 * 0.002) / 5.0);
+        let half = gate(&["coupling.structure_courant=0.025"]);
+        assert_eq!(step_after(&half, v.clone()), 0.025 * (1.3 * 0.002) / 5.0);
+        // At rest, switched off, or with a contact that corrects nothing: no bound.
+        assert_eq!(step_after(&scene, vec![[0.0; 2]; 3]), 1.0);
+        assert_eq!(step_after(&gate(&["coupling.structure_courant=0"]), v.clone()), 1.0);
+        assert_eq!(
+            step_after(&gate(&["contact.algorithm=particle_particle"]), v.clone()),
+            1.0
+        );
+        assert_eq!(step_after(&gate(&["contact.algorithm=none"]), v), 1.0);
     }
 }

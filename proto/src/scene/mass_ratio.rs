@@ -72,9 +72,14 @@ impl Scene {
 
     /// With ISPH, a coupling step of `coupling_dt` spanning `fem_steps` FE steps of `fem_dt` each: a warning where it
     /// spans at least [`LONG_COUPLING_STEP`] of them against a solid whose cells a particle outweighs
-    /// [`LONG_STEP_RATIO`] times, naming a `coupling.max_dt` of 24 FE steps.
+    /// [`LONG_STEP_RATIO`] times, naming a `coupling.max_dt` of 24 FE steps. None where the structure's speed bounds
+    /// the step (`coupling.structure_courant` > 0 with `particle_element`: the 4 mm gate at ISPH's own step then
+    /// keeps within the run's energy warning, docs/CORRECTIONS.md "The coupling step bounded by the structure's
+    /// speed").
     pub fn long_coupling_step_warning(&self, coupling_dt: f64, fem_dt: f64, fem_steps: u64) -> Option<String> {
-        let isph = self.fluid.as_ref()?.solver == FluidSolver::Isph;
+        let bounded =
+            self.coupling.structure_courant > 0.0 && self.contact.algorithm == ContactAlgorithm::ParticleElement;
+        let isph = self.fluid.as_ref()?.solver == FluidSolver::Isph && !bounded;
         let (name, ratio) = self
             .particle_to_cell_mass()
             .into_iter()
@@ -84,10 +89,16 @@ impl Scene {
                 "with ISPH the coupling step ({coupling_dt:.2e} s) spans {fem_steps} FE steps of the structure, and a \
                  fluid particle weighs {ratio:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
                  step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
-                 free, made the 4 mm gate unstable); try coupling.max_dt = {:.0e}, or damp the structure's ringing \
-                 ({}.mesh_damping = 0.25: the 4 mm gate then ends at ISPH's own step; docs/CORRECTIONS.md)",
+                 free, made the 4 mm gate unstable without a bound from the structure's speed); try coupling.max_dt = \
+                 {:.0e}, or damp the structure's ringing ({}.mesh_damping = 0.25: the 4 mm gate then ends at ISPH's own \
+                 step; docs/CORRECTIONS.md){}",
                 24.0 * fem_dt,
-                self.solid_key(name)
+                self.solid_key(name),
+                match self.contact.algorithm {
+                    ContactAlgorithm::ParticleElement => ", or bound the step by the structure's speed again \
+                                                          (coupling.structure_courant = 0.05)",
+                    _ => "",
+                }
             )
         })
     }
@@ -128,12 +139,21 @@ mod tests {
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
         assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
         // The coupling step's length in FE steps: with ISPH only, from 32 FE steps, and naming 24 of them.
-        let isph = gate(&["fluid.solver=\"isph\""]);
+        // Without the bound from the structure's speed, which the default sets (`coupling.structure_courant`).
+        let isph = gate(&["fluid.solver=\"isph\"", "coupling.structure_courant=0"]);
         let w = isph.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).unwrap();
         assert!(
-            w.contains("spans 151 FE steps") && w.contains("coupling.max_dt = 1e-4"),
+            w.contains("spans 151 FE steps")
+                && w.contains("coupling.max_dt = 1e-4")
+                && w.contains("coupling.structure_courant = 0.05"),
             "{w}"
         );
+        assert!(gate(&["fluid.solver=\"isph\""])
+            .long_coupling_step_warning(6.3e-4, 4.16e-6, 151)
+            .is_none());
+        let pp = gate(&["fluid.solver=\"isph\"", "contact.algorithm=\"particle_particle\""]);
+        let w = pp.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).unwrap();
+        assert!(!w.contains("structure_courant"), "{w}");
         assert!(isph.long_coupling_step_warning(1e-4, 4.16e-6, 25).is_none());
         assert!(scene.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).is_none());
     }

@@ -219,6 +219,16 @@ impl Scene {
             || "coupling.fem_cfl".into(),
             || format!("must be in (0, 0.9], got {}", self.coupling.fem_cfl),
         )?;
+        check(
+            self.coupling.structure_courant.is_finite() && (0.0..=1.0).contains(&self.coupling.structure_courant),
+            || "coupling.structure_courant".into(),
+            || {
+                format!(
+                    "must be in [0, 1] (0: no bound from the structure's speed), got {}",
+                    self.coupling.structure_courant
+                )
+            },
+        )?;
         if let Some(t) = self.contact.thickness {
             finite_positive("contact.thickness", t)?;
         }

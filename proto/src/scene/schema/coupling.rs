@@ -15,6 +15,29 @@ pub struct CouplingSpec {
     /// Seconds a node may take to answer one step before the run fails.
     #[serde(default = "default_step_timeout")]
     pub step_timeout: f64,
+    /// The structure's Courant number: with the `particle_element` contact a coupling step is at most
+    /// `structure_courant` · h / |v|_max, h the fluid's smoothing length and |v|_max the fastest interface node at the
+    /// end of the last step, so that the structure's surface moves at most that fraction of h between two contact
+    /// passes (docs/CORRECTIONS.md "The coupling step
+    /// bounded by the structure's speed"). In [0, 1]; 0 switches the bound off; default
+    /// [`STRUCTURE_COURANT_DEFAULT`]. Not written to `scene.toml` at its default.
+    #[serde(
+        default = "default_structure_courant",
+        skip_serializing_if = "is_default_structure_courant"
+    )]
+    pub structure_courant: f64,
+}
+
+/// The default of `coupling.structure_courant`: the largest of those measured (0.2, 0.1, 0.05) at which the ISPH
+/// gate at its own step keeps its energy (docs/CORRECTIONS.md).
+pub const STRUCTURE_COURANT_DEFAULT: f64 = 0.05;
+
+fn default_structure_courant() -> f64 {
+    STRUCTURE_COURANT_DEFAULT
+}
+
+fn is_default_structure_courant(c: &f64) -> bool {
+    *c == STRUCTURE_COURANT_DEFAULT
 }
 
 fn default_max_dt() -> f64 {
@@ -35,6 +58,7 @@ impl Default for CouplingSpec {
             max_dt: default_max_dt(),
             fem_cfl: default_fem_cfl(),
             step_timeout: default_step_timeout(),
+            structure_courant: default_structure_courant(),
         }
     }
 }

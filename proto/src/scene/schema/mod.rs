@@ -10,7 +10,7 @@ mod solid;
 use serde::{Deserialize, Serialize};
 
 pub use contact::{ContactAlgorithm, ContactSpec};
-pub use coupling::CouplingSpec;
+pub use coupling::{CouplingSpec, STRUCTURE_COURANT_DEFAULT};
 pub use fluid::{
     DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT,
     ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT,
