@@ -23,6 +23,11 @@ const PROCESS_BYTES: f64 = 20.0 * MIB;
 const WCSPH_PARTICLE_BYTES: f64 = 800.0;
 /// sph-node, per fluid particle: ISPH (the Poisson matrix and its Krylov vectors besides).
 const ISPH_PARTICLE_BYTES: f64 = 950.0;
+/// sph-node, per WCSPH fluid particle with Verlet candidate lists (`fluid.verlet_skin` > 0), per candidate: its
+/// index (u32); the candidates are those within 2h + skin, π (2h + skin)² / Δx² of them in the bulk.
+const VERLET_CANDIDATE_BYTES: f64 = 4.0;
+/// sph-node, per WCSPH fluid particle with Verlet candidate lists: the position they were gathered at.
+const VERLET_REFERENCE_BYTES: f64 = 16.0;
 /// sph-node, per wall particle: WCSPH.
 const WCSPH_WALL_BYTES: f64 = 250.0;
 /// sph-node, per wall particle: ISPH (walls have rows of the Poisson matrix).
@@ -157,7 +162,15 @@ impl Sizing {
             let dx = f.spacing;
             let h = f.smoothing_ratio * dx;
             let (per_particle, per_wall) = match f.solver {
-                FluidSolver::Wcsph => (WCSPH_PARTICLE_BYTES, WCSPH_WALL_BYTES),
+                FluidSolver::Wcsph => {
+                    let reach = (2.0 + f.verlet_skin()) * f.smoothing_ratio;
+                    let candidates = std::f64::consts::PI * reach * reach;
+                    let verlet = match f.verlet_skin() > 0.0 {
+                        true => candidates * VERLET_CANDIDATE_BYTES + VERLET_REFERENCE_BYTES,
+                        false => 0.0,
+                    };
+                    (WCSPH_PARTICLE_BYTES + verlet, WCSPH_WALL_BYTES)
+                }
                 FluidSolver::Isph => (ISPH_PARTICLE_BYTES, ISPH_WALL_BYTES),
             };
             s.fluid_particles = f.blocks.iter().map(|b| block_particles(b, dx)).sum();

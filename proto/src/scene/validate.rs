@@ -89,6 +89,21 @@ fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Res
         },
     )?;
     check(
+        f.verlet_skin().is_finite() && (0.0..=1.0).contains(&f.verlet_skin()),
+        || "fluid.verlet_skin".into(),
+        || {
+            format!(
+                "must be in [0, 1] (units of h; 0 searches every step), got {}",
+                f.verlet_skin()
+            )
+        },
+    )?;
+    check(
+        f.verlet_skin.is_none() || f.solver == FluidSolver::Wcsph,
+        || "fluid.verlet_skin".into(),
+        || "applies to solver = \"wcsph\" only (the ISPH search runs every step)".into(),
+    )?;
+    check(
         f.density_diffusion == 0.0 || f.solver == FluidSolver::Wcsph,
         || "fluid.density_diffusion".into(),
         || "applies to solver = \"wcsph\" only (ISPH takes its pressure from the Poisson equation)".into(),

@@ -218,7 +218,31 @@ impl SortedCells {
     #[inline]
     fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {
         let radius = kernel.support();
-        let r2max = radius * radius;
+        let n = self.scan_block(x, n_fluid, radius * radius, i, chunk);
+        let start = chunk.idx.len();
+        chunk.reserve_pairs(n, true);
+        chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
+        // r as `separation` computes it; the ∇W factor as `CubicSpline::grad`.
+        let d2 = std::mem::take(&mut chunk.cand_d2);
+        kernel.grad_factors(&d2[..n], chunk.kernel_values(start, n));
+        chunk.cand_d2 = d2;
+    }
+
+    /// Lists (no ∇W factors) of the particles closer to each fluid particle `0..n_fluid` of `x` than `radius` (at
+    /// most the cell size of the last sort), in the order of the module documentation: the candidates of a
+    /// [`super::VerletCandidates`] list.
+    pub fn build_candidate_lists(&self, x: &[[f64; 2]], n_fluid: usize, radius: f64, list: &mut NeighborList) {
+        list.build(n_fluid, |i, chunk| {
+            let n = self.scan_block(x, n_fluid, radius * radius, i, chunk);
+            chunk.reserve_pairs(n, false);
+            chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
+        });
+    }
+
+    /// Scans the 3 × 3 block of cells around fluid slot i, in gather order, into the chunk's candidate buffers;
+    /// the first of them (their count returned) are the particles j ≠ i with |x_i − x_j|² < `r2max`.
+    #[inline]
+    fn scan_block(&self, x: &[[f64; 2]], n_fluid: usize, r2max: f64, i: usize, chunk: &mut ListChunk) -> usize {
         let d0 = self.grid.dims()[0];
         let xi = x[i];
         let ([y0, y1], [x0, x1]) = self.grid.block(self.fluid_cell[i] as usize);
@@ -269,13 +293,7 @@ impl SortedCells {
                 }
             }
         }
-        let start = chunk.idx.len();
-        chunk.reserve_pairs(n, true);
-        chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
-        // r as `separation` computes it; the ∇W factor as `CubicSpline::grad`.
-        let d2 = std::mem::take(&mut chunk.cand_d2);
-        kernel.grad_factors(&d2[..n], chunk.kernel_values(start, n));
-        chunk.cand_d2 = d2;
+        n
     }
 
     /// The sorted fluid slots in the 3 × 3 block of cells around wall particle `w`, one range per row (empty

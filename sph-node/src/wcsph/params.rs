@@ -30,6 +30,9 @@ pub struct WcsphParams {
     /// The density diffusion leaves out the hydrostatic correction of Fourtakas et al. 2019 (plain Molteni &
     /// Colagrossi 2009; tests and comparisons only, no scene key).
     pub density_diffusion_uncorrected: bool,
+    /// Skin of the search's Verlet candidate lists in units of h (0: the cells are searched every step;
+    /// `fluid.verlet_skin`, [`crate::neighbors::VerletCandidates`]).
+    pub verlet_skin: f64,
 }
 
 impl WcsphParams {
@@ -56,6 +59,7 @@ impl WcsphParams {
             central_force: 0.0,
             density_diffusion: spec.density_diffusion,
             density_diffusion_uncorrected: false,
+            verlet_skin: spec.verlet_skin(),
         })
     }
 }

@@ -35,7 +35,7 @@ use crate::eos::Tait;
 use crate::error::{Result, SphError};
 use crate::integrator;
 use crate::kernel::CubicSpline;
-use crate::neighbors::{NeighborList, SortedCells};
+use crate::neighbors::{NeighborList, SortedCells, VerletCandidates};
 use crate::params::SphParams;
 use crate::particles::{max_norm, FluidState, ParticleView, WallParticles};
 use crate::setup::{self, FluidSetup};
@@ -73,6 +73,8 @@ struct Scratch {
     wall: Vec<(f64, f64)>,
     /// Positions (slot order) edited through `state_mut`, for the next drift; empty when none.
     edited_x: Vec<[f64; 2]>,
+    /// Verlet candidate lists, when on (`fluid.verlet_skin` > 0).
+    verlet: Option<VerletCandidates>,
 }
 
 /// Weakly compressible SPH solver.
@@ -156,6 +158,7 @@ impl WcsphSolver {
         let sorted = Sorted::new(&state, &walls);
         let scratch = Scratch {
             cells: SortedCells::new(&walls.x),
+            verlet: verlet_candidates(&wcsph, &params),
             ..Scratch::default()
         };
         let mut solver = Self {
@@ -463,4 +466,9 @@ impl WcsphSolver {
     fn unstable(&self, step: u64, particle: usize, reason: String) -> SphError {
         SphError::Unstable { step, particle, reason }
     }
+}
+
+/// The Verlet candidate lists of `wcsph.verlet_skin` (units of `params.h`), `None` when it is 0.
+fn verlet_candidates(wcsph: &WcsphParams, params: &SphParams) -> Option<VerletCandidates> {
+    (wcsph.verlet_skin > 0.0).then(|| VerletCandidates::new(wcsph.verlet_skin * params.h))
 }

@@ -77,6 +77,12 @@ pub struct FluidSpec {
     /// value). Not written to `scene.toml` when 0.
     #[serde(default, skip_serializing_if = "super::is_zero")]
     pub density_diffusion: f64,
+    /// Skin of the WCSPH neighbour search's Verlet candidate lists, in units of h (WCSPH only), in [0, 1]: the
+    /// candidates within the kernel support plus the skin are gathered from the cells and kept until a particle
+    /// has moved half the skin, and each step's lists are filtered from them. Default [`WCSPH_VERLET_SKIN_DEFAULT`];
+    /// 0 searches the cells every step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verlet_skin: Option<f64>,
     /// ISPH pressure Poisson source (isph only); default divergence_free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ppe_source: Option<PpeSourceKind>,
@@ -127,6 +133,9 @@ fn is_default_fluid_cfl(cfl: &f64) -> bool {
 /// 2009).
 pub const WCSPH_APD_DEFAULT: f64 = 0.04;
 
+/// Skin of the WCSPH Verlet candidate lists (units of h) when the scene names none (`fluid.verlet_skin`).
+pub const WCSPH_VERLET_SKIN_DEFAULT: f64 = 0.2;
+
 /// APD β of ISPH when the scene names none: the paper's, as for WCSPH.
 pub const ISPH_APD_DEFAULT: f64 = 0.04;
 
@@ -142,6 +151,15 @@ impl FluidSpec {
     /// The ISPH pressure solve's relative tolerance: the scene's, or [`ISPH_PPE_TOLERANCE_DEFAULT`].
     pub fn ppe_tolerance(&self) -> f64 {
         self.ppe_tolerance.unwrap_or(ISPH_PPE_TOLERANCE_DEFAULT)
+    }
+
+    /// The WCSPH search's Verlet skin in units of h: the scene's, or [`WCSPH_VERLET_SKIN_DEFAULT`] (0 for ISPH,
+    /// which does not use it).
+    pub fn verlet_skin(&self) -> f64 {
+        self.verlet_skin.unwrap_or(match self.solver {
+            FluidSolver::Wcsph => WCSPH_VERLET_SKIN_DEFAULT,
+            FluidSolver::Isph => 0.0,
+        })
     }
 
     /// APD β in force: the scene's, or the per-solver default (WCSPH [`WCSPH_APD_DEFAULT`], ISPH

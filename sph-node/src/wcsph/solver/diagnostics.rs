@@ -58,6 +58,7 @@ impl WcsphSolver {
             + b(&so.accel)
             + sc.cells.heap_bytes()
             + sc.list.heap_bytes()
+            + sc.verlet.as_ref().map_or(0, |v| v.heap_bytes())
             + b(&sc.src)
             + b(&sc.per1)
             + b(&sc.per2)

@@ -8,6 +8,8 @@ use super::WcsphSolver;
 use crate::boundary::adami;
 use crate::boundary::repulsion::Repulsion;
 use crate::corrections::apd;
+use crate::kernel::CubicSpline;
+use crate::neighbors::{NeighborList, SortedCells, VerletCandidates};
 use crate::wcsph::sorted::{permute, permute_spending, update_vol};
 use crate::wcsph::{continuity, momentum, MomentumParams};
 
@@ -121,13 +123,33 @@ impl WcsphSolver {
         self.sorted.accel = accel;
     }
 
-    /// Re-sorts the fluid by cell for the current positions and rebuilds the neighbour lists.
+    /// Re-sorts the fluid by cell for the current positions and rebuilds the neighbour lists (and the Verlet
+    /// candidates, when on).
     pub(super) fn rebuild_neighbors(&mut self) {
-        let nf = self.state.len();
+        if let Some(v) = &mut self.scratch.verlet {
+            v.clear();
+        }
         self.resort();
+        self.rebuild_lists();
+    }
+
+    /// Rebuilds the neighbour lists at the current positions, from the Verlet candidates when on, else from the
+    /// cells of the last sort.
+    pub(super) fn rebuild_lists(&mut self) {
+        let nf = self.state.len();
         let s = &self.sorted;
         let sc = &mut self.scratch;
-        sc.cells.build_fluid_lists(&s.x, nf, &self.kernel, &mut sc.list);
+        let (cells, verlet) = (&sc.cells, sc.verlet.as_ref());
+        search_and_map(
+            cells,
+            verlet,
+            &s.x,
+            nf,
+            &self.kernel,
+            &mut sc.list,
+            &mut Vec::new(),
+            |_, _, _| (),
+        );
     }
 
     /// [`WcsphSolver::rebuild_neighbors`] after the drift, with the density's half kick at the new positions
@@ -144,15 +166,27 @@ impl WcsphSolver {
         let (shift, mut drho) = (&sc.shift, std::mem::take(&mut sc.per1));
         let h = 0.5 * dt;
         if shift.is_empty() {
-            sc.cells
-                .build_fluid_lists_and_map(&s.x, nf, kernel, &mut sc.list, &mut drho, |i, idx, grad| {
-                    h * continuity::density_rate(i, &view, vol, idx, grad, diffusion.as_ref())
-                });
+            search_and_map(
+                &sc.cells,
+                sc.verlet.as_ref(),
+                &s.x,
+                nf,
+                kernel,
+                &mut sc.list,
+                &mut drho,
+                |i, idx, grad| h * continuity::density_rate(i, &view, vol, idx, grad, diffusion.as_ref()),
+            );
         } else {
-            sc.cells
-                .build_fluid_lists_and_map(&s.x, nf, kernel, &mut sc.list, &mut drho, |i, idx, grad| {
-                    continuity::density_increment(i, &view, vol, idx, grad, diffusion.as_ref(), shift, dt)
-                });
+            search_and_map(
+                &sc.cells,
+                sc.verlet.as_ref(),
+                &s.x,
+                nf,
+                kernel,
+                &mut sc.list,
+                &mut drho,
+                |i, idx, grad| continuity::density_increment(i, &view, vol, idx, grad, diffusion.as_ref(), shift, dt),
+            );
         }
         let s = &mut self.sorted;
         s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
@@ -161,15 +195,20 @@ impl WcsphSolver {
         self.scratch.shift.clear();
     }
 
-    /// Re-sorts the fluid (and the drift's APD shift, when there is one) by cell for the current positions.
+    /// Re-sorts the fluid (and the drift's APD shift, when there is one) by cell for the current positions, and
+    /// gathers the Verlet candidates when on; with Verlet candidates that still hold, nothing moves.
     fn resort(&mut self) {
         let nf = self.state.len();
         let s = &mut self.sorted;
         let sc = &mut self.scratch;
+        if sc.verlet.as_ref().is_some_and(|v| v.still_hold(&s.x[..nf])) {
+            return;
+        }
+        let skin = sc.verlet.as_ref().map_or(0.0, |v| v.skin());
         sc.cells.sort(
             &s.x[..nf],
             &self.walls.x,
-            self.kernel.support(),
+            self.kernel.support() + skin,
             &mut s.ids,
             &mut s.slot,
             &mut sc.src,
@@ -186,5 +225,30 @@ impl WcsphSolver {
             // its size is held for it (`src` is spent doing so; nothing reads it before the next sort).
             permute_spending(&mut sc.shift, &mut sc.src);
         }
+        if let Some(v) = &mut sc.verlet {
+            v.gather(&sc.cells, &s.x, nf, self.kernel.support());
+        }
+    }
+}
+
+/// The fluid's neighbour lists with their ∇W factors and `out[i] = f(i, neighbours, factors)`: from the Verlet
+/// candidates when on, else from the cells.
+#[allow(clippy::too_many_arguments)]
+fn search_and_map<T, F>(
+    cells: &SortedCells,
+    verlet: Option<&VerletCandidates>,
+    x: &[[f64; 2]],
+    nf: usize,
+    kernel: &CubicSpline,
+    list: &mut NeighborList,
+    out: &mut Vec<T>,
+    f: F,
+) where
+    T: Copy + Default + Send,
+    F: Fn(usize, &[u32], &[f64]) -> T + Sync,
+{
+    match verlet {
+        Some(v) => v.build_lists_and_map(x, kernel, list, out, f),
+        None => cells.build_fluid_lists_and_map(x, nf, kernel, list, out, f),
     }
 }

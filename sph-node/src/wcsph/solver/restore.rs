@@ -1,9 +1,11 @@
 //! A [`WcsphSolver`]'s state for a checkpoint, and the solver continued from it (see [`crate::restore`] for the
 //! checks). Saved: the particles, the walls' pressures and densities, the accelerations of the current time level
 //! (the next step's first half kick reads them), the wall guard's count, and, when the state has been edited since
-//! the last step, the positions of the last neighbour search (that step's first density rate and XSPH read them).
-//! Not saved: the cell order, the cell bins, the neighbour lists and the scratch, which are functions of the positions
-//! ([`crate::neighbors::SortedCells::sort`] orders by cell, then id) and are rebuilt as the step rebuilds them.
+//! the last step, the positions of the last neighbour search (that step's first density rate and XSPH read them),
+//! and, with Verlet candidate lists, the positions they were gathered at.
+//! Not saved: the cell order, the cell bins, the candidates, the neighbour lists and the scratch, which are functions
+//! of those positions ([`crate::neighbors::SortedCells::sort`] orders by cell, then id; the candidates are gathered
+//! from those cells and the lists filtered from them) and are rebuilt as the step rebuilt them.
 
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +24,9 @@ struct Own {
     wall_pushes: (u64, u64),
     /// Positions of the last neighbour search, in id order, when the state was edited since ([`WcsphSolver::state_mut`]).
     searched: Option<Vec<[f64; 2]>>,
+    /// Positions the Verlet candidates were gathered at, in id order, when the solver has them
+    /// ([`crate::neighbors::VerletCandidates::reference`]).
+    candidates_at: Option<Vec<[f64; 2]>>,
 }
 
 impl WcsphSolver {
@@ -31,10 +36,15 @@ impl WcsphSolver {
             let s = &self.sorted;
             s.slot.iter().map(|&k| s.x[k as usize]).collect()
         });
+        let candidates_at = self.scratch.verlet.as_ref().map(|v| {
+            let r = v.reference();
+            self.sorted.slot.iter().map(|&k| r[k as usize]).collect()
+        });
         let own = Own {
             accel: self.accel.clone(),
             wall_pushes: self.wall_pushes,
             searched,
+            candidates_at,
         };
         SavedSolver {
             solver: "wcsph".into(),
@@ -59,27 +69,58 @@ impl WcsphSolver {
             finite2("searched", x)?;
             inside("searched", x, domain)?;
         }
+        let verlet = super::verlet_candidates(&self.wcsph, &self.params);
+        match (&verlet, &own.candidates_at) {
+            (Some(v), Some(at)) => {
+                len("candidates_at", at, nf, "fluid particles")?;
+                finite2("candidates_at", at)?;
+                inside("candidates_at", at, domain)?;
+                let searched = own.searched.as_ref().unwrap_or(&saved.state.x);
+                if !v.within_half_skin(searched, at) {
+                    return Err(format!(
+                        "candidates_at: a particle is half the Verlet skin ({} m) or more from its searched position: \
+                         the candidates would miss neighbours",
+                        0.5 * v.skin()
+                    ));
+                }
+            }
+            (None, Some(_)) => return Err("candidates_at is saved, but the scene's fluid.verlet_skin is 0".into()),
+            (Some(_), None) => {
+                return Err("candidates_at is missing: the scene's fluid.verlet_skin is not 0".into());
+            }
+            (None, None) => {}
+        }
         self.state = saved.state;
         self.walls = saved.walls;
         self.accel = own.accel;
         self.wall_pushes = own.wall_pushes;
-        // The working copy in id order, then sorted by cell as `rebuild_neighbors` sorts it after a drift.
+        // The working copy in id order, then sorted by cell as `rebuild_neighbors` sorted it: at the positions the
+        // candidates were gathered at, when there are candidates, else at those of the last search.
+        let edited = own.searched.is_some();
+        let searched = own.searched.unwrap_or_else(|| self.state.x.clone());
         let mut sorted = Sorted::new(&self.state, &self.walls);
-        if let Some(x) = &own.searched {
-            sorted.x[..nf].copy_from_slice(x);
-        }
+        sorted.x[..nf].copy_from_slice(own.candidates_at.as_ref().unwrap_or(&searched));
         sorted.accel.copy_from_slice(&self.accel);
         self.sorted = sorted;
         self.scratch = Scratch {
             cells: SortedCells::new(&self.walls.x),
+            verlet,
             ..Scratch::default()
         };
         self.rebuild_neighbors();
+        if own.candidates_at.is_some() {
+            // The lists of the last search, filtered from the candidates at its positions.
+            let s = &mut self.sorted;
+            for (x, &id) in s.x[..nf].iter_mut().zip(&s.ids) {
+                *x = searched[id as usize];
+            }
+            self.rebuild_lists();
+        }
         let s = &mut self.sorted;
         for ((pr2, p), r) in s.pr2.iter_mut().zip(&s.p).zip(&s.rho) {
             *pr2 = p / (r * r);
         }
-        self.state_edited = own.searched.is_some();
+        self.state_edited = edited;
         Ok(())
     }
 }
@@ -129,6 +170,21 @@ mod tests {
         assert_eq!(e, format!("searched holds 3 entries, there are {n} fluid particles"));
         let e = refused(|o| o.searched = Some(vec![[1e200, 0.0]; n]));
         assert_eq!(e, "searched[0] = [1e200, 0.0] is outside the fluid's domain");
+        let e = refused(|o| o.candidates_at = None);
+        assert_eq!(e, "candidates_at is missing: the scene's fluid.verlet_skin is not 0");
+        let e = refused(|o| {
+            o.candidates_at.as_mut().unwrap().pop();
+        });
+        assert_eq!(
+            e,
+            format!("candidates_at holds {} entries, there are {n} fluid particles", n - 1)
+        );
+        let skin = stepped().scratch.verlet.as_ref().map(|v| v.skin()).unwrap();
+        let e = refused(|o| o.candidates_at.as_mut().unwrap()[7][0] += 0.6 * skin);
+        assert!(
+            e.starts_with("candidates_at: a particle is half the Verlet skin"),
+            "{e}"
+        );
     }
 
     /// The cell order, the cell bins and the neighbour lists rebuilt on restore are those the step left.
@@ -140,6 +196,9 @@ mod tests {
         assert_eq!(fresh.sorted.ids, solver.sorted.ids);
         assert_eq!(fresh.scratch.cells.differs_from(&solver.scratch.cells), None);
         assert_eq!(fresh.scratch.list.differs_from(&solver.scratch.list), None);
+        let (a, b) = (fresh.scratch.verlet.as_ref(), solver.scratch.verlet.as_ref());
+        assert!(b.is_some(), "the scene's default searches with Verlet candidates");
+        assert_eq!(a.zip(b).and_then(|(a, b)| a.differs_from(b)), None);
         let bits = |a: &[f64]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&fresh.sorted.vol), bits(&solver.sorted.vol));
         assert_eq!(bits(&fresh.sorted.pr2), bits(&solver.sorted.pr2));
