@@ -100,6 +100,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
                 "xsph": f.xsph,
                 "apd": f.apd(),
                 "density_diffusion": f.density_diffusion,
+                "verlet_skin": f.verlet_skin(),
             })),
         });
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -163,6 +164,13 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             f.xsph,
             f.apd()
         );
+        if f.verlet_skin() > 0.0 {
+            println!(
+                "  search: Verlet candidates within 2h + {} h, gathered again when a particle has moved {} h",
+                f.verlet_skin(),
+                0.5 * f.verlet_skin()
+            );
+        }
     }
     match (dt_fem, substeps) {
         (Some(d), Some(k)) => println!(

@@ -295,3 +295,34 @@ fn reaction_relaxation_is_a_fraction_for_particle_particle_only() {
         "{e}"
     );
 }
+
+#[test]
+fn verlet_skin_is_for_wcsph_in_its_range_and_defaults_to_0_2() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/dam_break.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("d.toml", &text, &[]).unwrap();
+    assert_eq!(s.fluid.as_ref().unwrap().verlet_skin(), 0.2);
+    assert_eq!(cosim_proto::scene::WCSPH_VERLET_SKIN_DEFAULT, 0.2);
+    // At the default the resolved scene is written as before (checkpoints compare it line by line).
+    assert!(!s.to_toml().lines().any(|l| l.starts_with("verlet_skin")));
+    for ok in ["0", "0.5", "1"] {
+        let s = parse("d.toml", &text, &[format!("fluid.verlet_skin={ok}")]).unwrap();
+        assert_eq!(s.fluid.as_ref().unwrap().verlet_skin(), ok.parse::<f64>().unwrap());
+        assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    }
+    for bad in ["1.5", "-0.1", "nan", "inf"] {
+        let e = err(&text, &[&format!("fluid.verlet_skin={bad}")]);
+        assert!(
+            e.starts_with("f.toml: fluid.verlet_skin: must be in [0, 1] (units of h; 0 searches every step)"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    let isph = parse("d.toml", &text, &["fluid.solver=\"isph\"".into()]).unwrap();
+    assert_eq!(isph.fluid.as_ref().unwrap().verlet_skin(), 0.0);
+    let e = err(&text, &["fluid.solver=\"isph\"", "fluid.verlet_skin=0.2"]);
+    assert_eq!(
+        e,
+        "f.toml: fluid.verlet_skin: applies to solver = \"wcsph\" only (the ISPH search runs every step)"
+    );
+}

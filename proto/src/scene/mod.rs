@@ -25,6 +25,6 @@ pub use schema::{
     Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter, ElementKind, EnergyOf,
     EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind, ProbeSpec,
     ReferenceSpec, RunSpec, Scene, SolidSpec, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT, ISPH_PPE_TOLERANCE_RANGE,
-    SCENE_VERSION, STRUCTURE_COURANT_DEFAULT, WCSPH_APD_DEFAULT,
+    SCENE_VERSION, STRUCTURE_COURANT_DEFAULT, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use sensors::{face_mean as sensors_face_mean, PressureSensor};

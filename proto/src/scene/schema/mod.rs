@@ -13,7 +13,7 @@ pub use contact::{ContactAlgorithm, ContactSpec};
 pub use coupling::{CouplingSpec, STRUCTURE_COURANT_DEFAULT};
 pub use fluid::{
     DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT,
-    ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT,
+    ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use probe::{Average, Component, EnergyOf, EnergyPart, ProbeKind, ProbeSpec, ReferenceSpec};
 pub use solid::{ElementKind, MaterialModel, MaterialSpec, SolidSpec};
