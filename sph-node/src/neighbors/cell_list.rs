@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 
 use super::grid::Grid;
+use crate::kernel::CubicSpline;
 
 /// Particles binned on a uniform grid.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -256,6 +257,19 @@ impl ListChunk {
             self.grad.resize(end, 0.0);
         }
         &mut self.grad[start..end]
+    }
+
+    /// Appends the first `n` candidates of the builder's scratch (`cand_idx`, with their squared distances in
+    /// `cand_d2`) as pairs of the particle being gathered, with their ∇W factors: r as `separation` computes it, the
+    /// factor as `CubicSpline::grad`.
+    #[inline]
+    pub(super) fn push_candidates(&mut self, n: usize, kernel: &CubicSpline) {
+        let start = self.idx.len();
+        self.reserve_pairs(n, true);
+        self.idx.extend_from_slice(&self.cand_idx[..n]);
+        let d2 = std::mem::take(&mut self.cand_d2);
+        kernel.grad_factors(&d2[..n], self.kernel_values(start, n));
+        self.cand_d2 = d2;
     }
 
     /// The neighbours of the chunk's `k`-th particle and the bits of their ∇W factors (none when the builder did not

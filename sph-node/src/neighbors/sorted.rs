@@ -219,13 +219,7 @@ impl SortedCells {
     fn gather_fluid(&self, x: &[[f64; 2]], n_fluid: usize, kernel: &CubicSpline, i: usize, chunk: &mut ListChunk) {
         let radius = kernel.support();
         let n = self.scan_block(x, n_fluid, radius * radius, i, chunk);
-        let start = chunk.idx.len();
-        chunk.reserve_pairs(n, true);
-        chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
-        // r as `separation` computes it; the ∇W factor as `CubicSpline::grad`.
-        let d2 = std::mem::take(&mut chunk.cand_d2);
-        kernel.grad_factors(&d2[..n], chunk.kernel_values(start, n));
-        chunk.cand_d2 = d2;
+        chunk.push_candidates(n, kernel);
     }
 
     /// Lists (no ∇W factors) of the particles closer to each fluid particle `0..n_fluid` of `x` than `radius` (at

@@ -136,13 +136,7 @@ impl VerletCandidates {
             cand_d2[n] = d2;
             n += usize::from(d2 < r2max);
         }
-        let start = chunk.idx.len();
-        chunk.reserve_pairs(n, true);
-        chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);
-        // r as `separation` computes it; the ∇W factor as `CubicSpline::grad`.
-        let d2 = std::mem::take(&mut chunk.cand_d2);
-        kernel.grad_factors(&d2[..n], chunk.kernel_values(start, n));
-        chunk.cand_d2 = d2;
+        chunk.push_candidates(n, kernel);
     }
 
     /// The first part in which these candidates (rebuilt on restore) differ from `other`; `None` when the same.
