@@ -197,7 +197,7 @@ impl WcsphSolver {
 
     /// Re-sorts the fluid (and the drift's APD shift, when there is one) by cell for the current positions, and
     /// gathers the Verlet candidates when on; with Verlet candidates that still hold, nothing moves.
-    fn resort(&mut self) {
+    pub(super) fn resort(&mut self) {
         let nf = self.state.len();
         let s = &mut self.sorted;
         let sc = &mut self.scratch;

@@ -107,15 +107,16 @@ impl WcsphSolver {
             verlet,
             ..Scratch::default()
         };
-        self.rebuild_neighbors();
+        // The fresh scratch has no candidates: the sort runs (and gathers them, when on).
+        self.resort();
         if own.candidates_at.is_some() {
-            // The lists of the last search, filtered from the candidates at its positions.
+            // The lists of the last search are filtered from the candidates at its positions.
             let s = &mut self.sorted;
             for (x, &id) in s.x[..nf].iter_mut().zip(&s.ids) {
                 *x = searched[id as usize];
             }
-            self.rebuild_lists();
         }
+        self.rebuild_lists();
         let s = &mut self.sorted;
         for ((pr2, p), r) in s.pr2.iter_mut().zip(&s.p).zip(&s.rho) {
             *pr2 = p / (r * r);
