@@ -165,29 +165,21 @@ impl WcsphSolver {
         let (view, vol, kernel) = (s.view(nf), &s.vol, &self.kernel);
         let (shift, mut drho) = (&sc.shift, std::mem::take(&mut sc.per1));
         let h = 0.5 * dt;
-        if shift.is_empty() {
-            search_and_map(
-                &sc.cells,
-                sc.verlet.as_ref(),
-                &s.x,
-                nf,
-                kernel,
-                &mut sc.list,
-                &mut drho,
-                |i, idx, grad| h * continuity::density_rate(i, &view, vol, idx, grad, diffusion.as_ref()),
-            );
-        } else {
-            search_and_map(
-                &sc.cells,
-                sc.verlet.as_ref(),
-                &s.x,
-                nf,
-                kernel,
-                &mut sc.list,
-                &mut drho,
-                |i, idx, grad| continuity::density_increment(i, &view, vol, idx, grad, diffusion.as_ref(), shift, dt),
-            );
-        }
+        // The half kick's density change of each particle: the rate's alone, or with the drift's APD shift.
+        let change = |i, idx: &[u32], grad: &[f64]| match shift.is_empty() {
+            true => h * continuity::density_rate(i, &view, vol, idx, grad, diffusion.as_ref()),
+            false => continuity::density_increment(i, &view, vol, idx, grad, diffusion.as_ref(), shift, dt),
+        };
+        search_and_map(
+            &sc.cells,
+            sc.verlet.as_ref(),
+            &s.x,
+            nf,
+            kernel,
+            &mut sc.list,
+            &mut drho,
+            change,
+        );
         let s = &mut self.sorted;
         s.rho[..nf].iter_mut().zip(&drho).for_each(|(r, d)| *r += d);
         update_vol(&mut s.vol[..nf], &s.m[..nf], &s.rho[..nf]);
