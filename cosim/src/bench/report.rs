@@ -82,12 +82,7 @@ fn cases_section(md: &mut String, cases: &[Case]) {
         let c = g[0];
         let spacings: Vec<String> = g.iter().map(|c| c.spacing.to_string()).collect();
         let ends: Vec<String> = dedup(g.iter().map(|c| c.end_time.to_string()));
-        let extra: Vec<String> = dedup(g.iter().flat_map(|c| {
-            c.extra
-                .iter()
-                .filter(|s| !s.starts_with("run.output_interval"))
-                .cloned()
-        }));
+        let extra = other_sets(g);
         let _ = writeln!(
             md,
             "| {} | {} | {} | `{}` | {} | {} | {} | {} |",
@@ -97,11 +92,7 @@ fn cases_section(md: &mut String, cases: &[Case]) {
             c.scene.display(),
             spacings.join(", "),
             ends.join(", "),
-            if extra.is_empty() {
-                "–".into()
-            } else {
-                format!("`{}`", extra.join("`, `"))
-            },
+            extra,
             c.threads.map_or("all".into(), |n| n.to_string()),
         );
     }
@@ -139,6 +130,40 @@ fn cases_section(md: &mut String, cases: &[Case]) {
         }
     }
     md.push('\n');
+}
+
+/// The "other `--set`" cell of a group of cases (one case at several spacings): the overrides every case of the group
+/// has, then, where some differ between spacings (the Lobovsky sensor probes, half a spacing in front of the wall),
+/// each spacing's own; `run.output_interval` is left out (how often a run writes, not what it computes).
+fn other_sets(group: &[&Case]) -> String {
+    let shown = |c: &Case| -> Vec<String> {
+        let keep = |s: &&String| !s.starts_with("run.output_interval");
+        dedup(c.extra.iter().filter(keep).cloned())
+    };
+    let each: Vec<Vec<String>> = group.iter().map(|c| shown(c)).collect();
+    let quote = |sets: &[String]| format!("`{}`", sets.join("`, `"));
+    let common: Vec<String> = each
+        .first()
+        .map(|first| {
+            let everywhere = |s: &&String| each.iter().all(|e| e.contains(s));
+            first.iter().filter(everywhere).cloned().collect()
+        })
+        .unwrap_or_default();
+    let mut parts = Vec::new();
+    if !common.is_empty() {
+        parts.push(quote(&common));
+    }
+    for (c, sets) in group.iter().zip(&each) {
+        let own: Vec<String> = sets.iter().filter(|s| !common.contains(s)).cloned().collect();
+        if !own.is_empty() {
+            parts.push(format!("at Δx = {}: {}", c.spacing, quote(&own)));
+        }
+    }
+    if parts.is_empty() {
+        "–".into()
+    } else {
+        parts.join("; ")
+    }
 }
 
 fn dedup(items: impl Iterator<Item = String>) -> Vec<String> {
@@ -366,4 +391,51 @@ fn scaling_section(md: &mut String, records: &[Record]) {
         let _ = writeln!(md, "- Speed-up 1 → 2 threads (fluid compute): {}.", speedups.join(", "));
     }
     md.push('\n');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(spacing: f64, extra: &[&str]) -> Case {
+        Case {
+            case: "lobovsky_dam_break",
+            variant: "",
+            scene: "scenes/lobovsky_dam_break.toml".into(),
+            solver: "wcsph",
+            contact: "none",
+            spacing,
+            end_time: 1.25,
+            threads: None,
+            repeats: 1,
+            extra: extra.iter().map(|s| s.to_string()).collect(),
+            metric: Metric::Lobovsky,
+        }
+    }
+
+    /// Overrides that differ between the spacings of a case are shown with their spacing, not merged into one list
+    /// that no run had; those that all share come first, once.
+    #[test]
+    fn per_spacing_overrides_are_listed_with_their_spacing() {
+        let a = case(
+            0.01,
+            &[
+                "fluid.density_diffusion=0.5",
+                "probe[0].point=[1.605,0.003]",
+                "run.output_interval=0.01",
+            ],
+        );
+        let b = case(0.005, &["fluid.density_diffusion=0.5", "probe[0].point=[1.6075,0.003]"]);
+        assert_eq!(
+            other_sets(&[&a, &b]),
+            "`fluid.density_diffusion=0.5`; at Δx = 0.01: `probe[0].point=[1.605,0.003]`; \
+             at Δx = 0.005: `probe[0].point=[1.6075,0.003]`"
+        );
+        assert_eq!(
+            other_sets(&[&case(0.01, &[]), &case(0.005, &["run.output_interval=1"])]),
+            "–"
+        );
+        let same = case(0.01, &["fluid.apd=0"]);
+        assert_eq!(other_sets(&[&same, &case(0.005, &["fluid.apd=0"])]), "`fluid.apd=0`");
+    }
 }
