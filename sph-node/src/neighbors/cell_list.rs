@@ -194,6 +194,11 @@ impl ListChunk {
         &self.idx[self.range(k)]
     }
 
+    /// Empties the chunk for `particles` particles from `first`, for a builder outside [`NeighborList`].
+    pub(super) fn begin(&mut self, first: usize, particles: usize) {
+        self.clear(first, particles);
+    }
+
     fn clear(&mut self, first: usize, particles: usize) {
         self.first = first;
         self.particles = particles;
@@ -283,7 +288,7 @@ impl ListChunk {
         Some((self.idx.get(r)?, grad))
     }
 
-    fn close_particle(&mut self) {
+    pub(super) fn close_particle(&mut self) {
         self.start.push(self.idx.len() as u32);
     }
 }

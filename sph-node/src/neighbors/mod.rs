@@ -1,5 +1,6 @@
 //! Neighbour search.
 
+pub mod candidates;
 pub mod cell_list;
 pub mod grid;
 pub mod sorted;

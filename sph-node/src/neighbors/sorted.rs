@@ -13,6 +13,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::candidates::CandidateLists;
 use super::cell_list::{ListChunk, NeighborList};
 use super::grid::Grid;
 use crate::kernel::CubicSpline;
@@ -225,8 +226,8 @@ impl SortedCells {
     /// Lists (no ∇W factors) of the particles closer to each fluid particle `0..n_fluid` of `x` than `radius` (at
     /// most the cell size of the last sort), in the order of the module documentation: the candidates of a
     /// [`super::VerletCandidates`] list.
-    pub fn build_candidate_lists(&self, x: &[[f64; 2]], n_fluid: usize, radius: f64, list: &mut NeighborList) {
-        list.build(n_fluid, |i, chunk| {
+    pub fn build_candidate_lists(&self, x: &[[f64; 2]], n_fluid: usize, radius: f64, list: &mut CandidateLists) {
+        list.build(n_fluid, n_fluid, |i, chunk| {
             let n = self.scan_block(x, n_fluid, radius * radius, i, chunk);
             chunk.reserve_pairs(n, false);
             chunk.idx.extend_from_slice(&chunk.cand_idx[..n]);

@@ -11,6 +11,7 @@
 
 use rayon::prelude::*;
 
+use super::candidates::CandidateLists;
 use super::cell_list::{ListChunk, NeighborList};
 use super::sorted::SortedCells;
 use crate::kernel::CubicSpline;
@@ -20,8 +21,9 @@ use crate::kernel::CubicSpline;
 pub struct VerletCandidates {
     /// Skin (a length) beyond the kernel support.
     skin: f64,
-    /// The candidates of each fluid particle (slots of the sort they were gathered after; no ∇W factors).
-    candidates: NeighborList,
+    /// The candidates of each fluid particle (slots of the sort they were gathered after, in 2-byte codes where a
+    /// chunk's slots fit: [`CandidateLists`]; no ∇W factors).
+    candidates: CandidateLists,
     /// Fluid positions (slot order) when the candidates were gathered; empty before the first gather.
     x_ref: Vec<[f64; 2]>,
     /// Gathers since the candidates were made (diagnostics).
@@ -127,7 +129,7 @@ impl VerletCandidates {
         let mut n = 0;
         let (cand_idx, cand_d2) = (&mut chunk.cand_idx[..total], &mut chunk.cand_d2[..total]);
         // Branch-free compaction, as the cells' scan.
-        for &j in cand {
+        cand.for_each(|j| {
             let p = x[j as usize];
             let dx = xi[0] - p[0];
             let dy = xi[1] - p[1];
@@ -135,7 +137,7 @@ impl VerletCandidates {
             cand_idx[n] = j;
             cand_d2[n] = d2;
             n += usize::from(d2 < r2max);
-        }
+        });
         chunk.push_candidates(n, kernel);
     }
 
