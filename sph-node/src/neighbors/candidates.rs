@@ -4,7 +4,7 @@
 //! slots of the few cell rows the chunk touches, and wall slots (which follow the fluid's) of the same rows. Each
 //! candidate is kept as a `u16` code: codes below `split` are fluid slots counted from the chunk's smallest fluid
 //! candidate, codes from `split` on are wall slots counted from its smallest wall candidate. A chunk whose two runs
-//! do not fit in 65,536 codes together keeps its candidates as `u32` slots. Either way a candidate decodes to the
+//! need more than 65,535 codes together keeps its candidates as `u32` slots. Either way a candidate decodes to the
 //! slot it was gathered as, in the order it was gathered: the filter sees the same slots as with `u32` lists.
 
 use rayon::prelude::*;
@@ -181,7 +181,7 @@ impl CandidateLists {
             let first = c * CHUNK;
             let last = (first + CHUNK).min(n);
             let mut built = ListChunk::default();
-            built.begin(first, last - first);
+            built.clear(first, last - first);
             for i in first..last {
                 gather(i, &mut built);
                 built.close_particle();

@@ -194,12 +194,8 @@ impl ListChunk {
         &self.idx[self.range(k)]
     }
 
-    /// Empties the chunk for `particles` particles from `first`, for a builder outside [`NeighborList`].
-    pub(super) fn begin(&mut self, first: usize, particles: usize) {
-        self.clear(first, particles);
-    }
-
-    fn clear(&mut self, first: usize, particles: usize) {
+    /// Empties the chunk for `particles` particles from `first` (also for a builder outside [`NeighborList`]).
+    pub(super) fn clear(&mut self, first: usize, particles: usize) {
         self.first = first;
         self.particles = particles;
         self.kernel_written = false;
