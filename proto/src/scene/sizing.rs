@@ -19,13 +19,16 @@ pub const MAX_COUNT: f64 = u32::MAX as f64;
 
 /// Bytes of one process before any particle or node: the program, its libraries, zenoh, the thread pool.
 const PROCESS_BYTES: f64 = 20.0 * MIB;
-/// sph-node, per fluid particle: WCSPH (lists, id-ordered and sorted state, scratch, the state messages).
-const WCSPH_PARTICLE_BYTES: f64 = 800.0;
-/// sph-node, per fluid particle: ISPH (the Poisson matrix and its Krylov vectors besides).
-const ISPH_PARTICLE_BYTES: f64 = 950.0;
+/// sph-node, per fluid particle: WCSPH (lists, id-ordered and sorted state, scratch, the state messages). Was 800 B
+/// with 4 B a Verlet candidate; remeasured 2026-12-05 with the candidates' 2 B (docs/PERFORMANCE.md, "Scene sizing").
+const WCSPH_PARTICLE_BYTES: f64 = 850.0;
+/// sph-node, per fluid particle: ISPH (the Poisson matrix, its Krylov vectors and the multigrid preconditioner's
+/// levels besides). Was 950 B, measured 2026-11-25, before the multigrid preconditioner landed; remeasured 2026-12-05.
+const ISPH_PARTICLE_BYTES: f64 = 1250.0;
 /// sph-node, per WCSPH fluid particle with Verlet candidate lists (`fluid.verlet_skin` > 0), per candidate: its
-/// index (u32); the candidates are those within 2h + skin, π (2h + skin)² / Δx² of them in the bulk.
-const VERLET_CANDIDATE_BYTES: f64 = 4.0;
+/// code (u16; a chunk spanning more than 65,535 slots keeps u32 slots instead, `sph-node/src/neighbors/candidates.rs`);
+/// the candidates are those within 2h + skin, π (2h + skin)² / Δx² of them in the bulk.
+const VERLET_CANDIDATE_BYTES: f64 = 2.0;
 /// sph-node, per WCSPH fluid particle with Verlet candidate lists: the position they were gathered at.
 const VERLET_REFERENCE_BYTES: f64 = 16.0;
 /// sph-node, per wall particle: WCSPH.
