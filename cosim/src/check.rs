@@ -36,19 +36,19 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let (particles, walls, dt_fluid) = fluid.as_ref().map_or((0, 0, f64::INFINITY), |f| {
         (f.setup().particles as usize, f.setup().walls.len(), f.setup().dt_stable)
     });
-    // Fluid-only runs sub-cycle inside the fluid node; only coupled runs step the broker at the fluid's step.
+    // Fluid-only runs sub-cycle inside the fluid node; only coupled runs step the broker at the fluid's step (or
+    // `coupling.fluid_substeps` of them).
     let coupled = fluid.is_some() && !s.solids.is_empty();
-    let dt = s
-        .coupling
-        .max_dt
-        .min(s.run.output_interval)
-        .min(if coupled { dt_fluid } else { f64::INFINITY });
+    let dt = contact_broker::coordinator::first_step(s, !s.solids.is_empty(), dt_fluid);
     let steps = (s.run.end_time / dt).ceil() as u64;
     // WCSPH + particle_particle: the contact shortens the coupling step as the run goes (contact_step.rs).
     let contact_bound = coupled && contact_broker::contact_step::applies(s);
     let substeps = dt_fem.map(|d| (dt / d).ceil() as u64);
+    // How many fluid steps a coupling step spans at most (`coupling.fluid_substeps`; WCSPH with particle_element).
+    let fluid_span = s.fluid_steps_per_pass(dt_fluid);
     let ratios = s.particle_to_cell_mass();
     let mut warnings = s.heavy_particle_warnings();
+    warnings.extend(s.fluid_substeps_warning(dt_fluid));
     if let (true, Some(d), Some(k)) = (coupled, dt_fem, substeps) {
         warnings.extend(s.long_coupling_step_warning(dt, d, k));
     }
@@ -68,6 +68,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "coupling_dt": dt,
             "coupling_steps": steps,
             "coupling_dt_bounded_by_contact": contact_bound,
+            "coupling_fluid_steps_per_pass": coupled.then_some(fluid_span),
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
             // A fluid particle's mass over one mesh cell's, per solid (proto::scene::mass_ratio).
@@ -177,6 +178,13 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "  steps: coupling dt {dt} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
         ),
         _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
+    }
+    if coupled && fluid_span > 1 {
+        println!(
+            "  coupling: a contact pass every {fluid_span} fluid steps at most (coupling.fluid_substeps = {}; 1: after \
+             every fluid step, the paper's lockstep)",
+            s.coupling.fluid_substeps
+        );
     }
     for (name, ratio) in &ratios {
         println!("  contact: a fluid particle weighs {ratio:.1} cells of solid {name}");

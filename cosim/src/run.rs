@@ -118,7 +118,14 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     }
     prepare_out(&out, scene, &info, own_folder)?;
     // Not refused: a mesh that fine for this fluid runs, but its energy is not to be trusted (mass_ratio.rs).
-    for w in scene.scene.heavy_particle_warnings() {
+    // The fluid's first stable step estimated from the scene (WCSPH at rest): how many of them a contact pass spans.
+    let s = &scene.scene;
+    let dt_fluid = s
+        .fluid
+        .as_ref()
+        .and_then(|f| sph_node::time_step::at_rest(f, s.run.gravity));
+    let substeps = s.fluid_substeps_warning(dt_fluid.unwrap_or(f64::INFINITY));
+    for w in s.heavy_particle_warnings().into_iter().chain(substeps) {
         eprintln!("cosim: warning: {w}");
     }
     let bar = Bar::new(args.quiet);

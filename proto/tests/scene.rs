@@ -141,6 +141,36 @@ fn fluid_cfl_defaults_to_one_and_is_refused_above_one() {
 }
 
 #[test]
+fn fluid_substeps_defaults_to_the_lockstep_in_its_range() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/hydrostatic_plate.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = parse("p.toml", &text, &[]).unwrap();
+    assert_eq!(s.coupling.fluid_substeps, 1);
+    // At the default the resolved scene is written as before (checkpoints compare it line by line).
+    assert!(!s.to_toml().lines().any(|l| l.starts_with("fluid_substeps")));
+    for ok in 1..=cosim_proto::scene::FLUID_SUBSTEPS_MAX {
+        let s = parse("p.toml", &text, &[format!("coupling.fluid_substeps={ok}")]).unwrap();
+        assert_eq!(s.coupling.fluid_substeps, ok);
+        assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
+    }
+    for bad in ["0", "5", "100"] {
+        let e = err(&text, &[&format!("coupling.fluid_substeps={bad}")]);
+        assert_eq!(
+            e,
+            format!(
+                "f.toml: coupling.fluid_substeps: must be a whole number in [1, 4] (1: a contact pass after every fluid \
+                 step), got {bad}"
+            )
+        );
+    }
+    for bad in ["2.5", "-1", "\"two\""] {
+        let e = err(&text, &[&format!("coupling.fluid_substeps={bad}")]);
+        assert!(e.starts_with("f.toml: coupling.fluid_substeps"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+}
+
+#[test]
 fn structure_courant_defaults_to_its_constant_in_its_range() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
     let text = std::fs::read_to_string(path).unwrap();

@@ -13,3 +13,12 @@ pub fn stable_dt(h: f64, c0: f64, v_max: f64, a_max: f64, nu: f64) -> f64 {
     }
     dt
 }
+
+/// The WCSPH stable step of a scene's fluid at rest, from the scene alone: `fluid.cfl` · 0.25 h / c0, the acoustic
+/// condition (at rest the force and viscous conditions allow more on every shipped scene; the solver's own first step
+/// is at most this). What `cosim run` sizes its warnings with before anything is built; `None` where c0 has no default
+/// (no gravity and no `fluid.sound_speed`).
+pub fn at_rest(spec: &cosim_proto::scene::FluidSpec, gravity: [f64; 2]) -> Option<f64> {
+    let c0 = crate::setup::sound_speed(spec, gravity).ok()?;
+    Some(spec.cfl * 0.25 * spec.smoothing_ratio * spec.spacing / c0)
+}

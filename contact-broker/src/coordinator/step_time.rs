@@ -1,7 +1,7 @@
 //! The run's clock (`DESIGN.md` §3 step 1): how long each coupling step is, and the output times the steps land
 //! on.
 
-use cosim_proto::scene::{ContactAlgorithm, Scene};
+use cosim_proto::scene::{ContactAlgorithm, Scene, SUBSTEP_SLACK};
 
 use super::exchange::Round;
 use crate::summary::Summary;
@@ -26,6 +26,8 @@ pub(super) struct Clock {
     pub dt_structure: f64,
     /// `coupling.structure_courant` · h: how far the structure's surface may move in one step [m] (0: no bound).
     reach: f64,
+    /// How many of the fluid's stable steps a coupling step may span ([`Scene::fluid_substeps`]).
+    fluid_substeps: f64,
     interval: f64,
     end: f64,
     max_dt: f64,
@@ -58,6 +60,12 @@ fn structure_reach(scene: &Scene) -> f64 {
     }
 }
 
+/// The first coupling step of `scene` as the broker fixes it (`cosim check`'s estimate): `structure` says whether a
+/// structure node takes part, `dt_fluid` is the fluid's first stable step (infinite without a fluid).
+pub fn first_step(scene: &Scene, structure: bool, dt_fluid: f64) -> f64 {
+    Clock::new(scene, structure, dt_fluid).next_step().dt
+}
+
 impl Clock {
     /// The clock at t = 0 of `scene`; `structure` says whether a structure node takes part, `dt_fluid` is the
     /// fluid's first stable step (infinite without a fluid).
@@ -70,6 +78,7 @@ impl Clock {
             dt_contact: f64::INFINITY,
             dt_structure: f64::INFINITY,
             reach: structure_reach(scene),
+            fluid_substeps: f64::from(scene.fluid_substeps()),
             interval: scene.run.output_interval,
             end: scene.run.end_time,
             max_dt: scene.coupling.max_dt,
@@ -87,16 +96,13 @@ impl Clock {
         self.t < self.end
     }
 
-    /// Fix the next coupling step: the fluid's stable step, the contact's and the structure's, capped by the user and
-    /// the next output time. Without a structure there is nothing to couple: the fluid node sub-cycles at its own stable
-    /// step.
+    /// Fix the next coupling step: the fluid's stable step (or several, [`Clock::fluid_span`]), the contact's and the
+    /// structure's, capped by the user and the next output time. Without a structure there is nothing to couple: the
+    /// fluid node sub-cycles at its own stable step.
     pub fn next_step(&mut self) -> Step {
         let target = (self.next_output as f64 * self.interval).min(self.end);
         let cap = if self.structure {
-            self.max_dt
-                .min(self.dt_fluid)
-                .min(self.dt_contact)
-                .min(self.dt_structure)
+            self.fluid_span(self.max_dt.min(self.dt_contact).min(self.dt_structure))
         } else {
             self.max_dt
         };
@@ -107,6 +113,20 @@ impl Clock {
         }
         self.step += 1;
         Step { dt, lands, target, cap }
+    }
+
+    /// The coupling step within `cap` (the user's, the contact's and the structure's bounds) that spans whole
+    /// fluid steps: lockstep, min(cap, Δt_fluid), where the scene's fluid sub-steps in force
+    /// ([`Scene::fluid_substeps`]) are 1 or the cap holds fewer than two fluid steps; otherwise n − [`SUBSTEP_SLACK`]
+    /// fluid steps, n the most of them, up to k, that fit in the cap (a cap of 3.3 steps gives 2.95, which the fluid
+    /// takes in 3 sub-steps, where 3.3 would take 4).
+    fn fluid_span(&self, cap: f64) -> f64 {
+        let whole = (cap / self.dt_fluid + SUBSTEP_SLACK).floor().min(self.fluid_substeps);
+        if whole >= 2.0 {
+            (whole - SUBSTEP_SLACK) * self.dt_fluid
+        } else {
+            cap.min(self.dt_fluid)
+        }
     }
 
     /// A contact pass allows the next step to be at most `dt` long (`None`: no bound); the bound holds for the rest
@@ -229,5 +249,46 @@ mod tests {
             1.0
         );
         assert_eq!(step_after(&gate(&["contact.algorithm=none"]), v), 1.0);
+    }
+
+    #[test]
+    fn a_coupling_step_spans_the_fluid_substeps_with_wcsph_and_particle_element_only() {
+        // The fluid's stable step 1e-5 s; the user's cap and the output times far away.
+        let first = |sets: &[&str]| {
+            let mut clock = Clock::new(&gate(sets), true, 1e-5);
+            (clock.max_dt, clock.end, clock.interval) = (1.0, 100.0, 1000.0);
+            clock.next_step().dt
+        };
+        assert_eq!(first(&["coupling.fluid_substeps=1"]), 1e-5);
+        // The shipped gate takes 4.
+        assert_eq!(first(&[]), (4.0 - SUBSTEP_SLACK) * 1e-5);
+        assert_eq!(first(&["coupling.fluid_substeps=3"]), (3.0 - SUBSTEP_SLACK) * 1e-5);
+        assert_eq!(first(&["coupling.fluid_substeps=4"]), (4.0 - SUBSTEP_SLACK) * 1e-5);
+        // particle_particle acts as a force once a coupling step, ISPH's own step is long: the paper's lockstep
+        // whatever the key says.
+        assert_eq!(
+            first(&["coupling.fluid_substeps=4", "contact.algorithm=particle_particle"]),
+            1e-5
+        );
+        assert_eq!(first(&["coupling.fluid_substeps=4", "fluid.solver=\"isph\""]), 1e-5);
+        // A cap between whole fluid steps is rounded down to them: coupling.max_dt = 3.3 fluid steps gives 2.95 (three
+        // sub-steps, where 3.3 would take four), 1.5 gives one (lockstep).
+        let capped = |max_dt: f64, v: Option<[f64; 2]>| {
+            let mut clock = Clock::new(&gate(&["coupling.fluid_substeps=4"]), true, 1e-5);
+            (clock.max_dt, clock.end, clock.interval) = (max_dt, 100.0, 1000.0);
+            if let Some(v) = v {
+                clock.structure_bound(&[v]);
+            }
+            clock.next_step().dt
+        };
+        assert_eq!(capped(3.3e-5, None), (3.0 - SUBSTEP_SLACK) * 1e-5);
+        assert_eq!(capped(1.5e-5, None), 1e-5);
+        assert_eq!(capped(0.5e-5, None), 0.5e-5);
+        // The structure's Courant bound caps it as well: 0.05 h / 5 m/s = 2.6e-5 s, 2.6 fluid steps: 1.95 of them.
+        assert_eq!(capped(1.0, Some([3.0, -4.0])), (2.0 - SUBSTEP_SLACK) * 1e-5);
+        // Without a fluid (an infinite stable step) the cap is the step.
+        let mut clock = Clock::new(&gate(&["coupling.fluid_substeps=4"]), true, f64::INFINITY);
+        (clock.max_dt, clock.end, clock.interval) = (2e-5, 100.0, 1000.0);
+        assert_eq!(clock.next_step().dt, 2e-5);
     }
 }

@@ -23,6 +23,14 @@ pub const LONG_COUPLING_STEP: u64 = 32;
 /// See [`LONG_COUPLING_STEP`]: the shipped gate's 3.6 is above it, the plate's 1.5 below.
 pub const LONG_STEP_RATIO: f64 = 3.0;
 
+/// With the fluid sub-cycled between contact passes (`coupling.fluid_substeps` > 1 in force): `cosim check` and `cosim
+/// run` warn where a fluid particle weighs more than this many cells of a solid. A pass every k fluid steps gives the
+/// mesh k-fold impulses k times less often. On the gate (0.2 s, WCSPH; `energy_growth` as a fraction of the budget)
+/// the 2 mm gate, 3.6 cells, kept its energy at 3 fluid steps a pass (0.0006, lockstep 0) and rang at 2 (0.035); the
+/// 4 mm gate, 14.5 cells, gained 0.050 / 0.059 / 0.083 at 2 / 3 / 4 against 0.0014 in lockstep
+/// (docs/CORRECTIONS.md "The fluid sub-cycled between contact passes").
+pub const SUBSTEP_RATIO: f64 = 4.0;
+
 impl SolidSpec {
     /// The mass of one cell of the mesh grid per unit depth [kg/m]: ρ_s times the cell's area (one quad4 element, two
     /// tri3 elements).
@@ -68,6 +76,26 @@ impl Scene {
                 )
             })
             .collect()
+    }
+
+    /// A warning where the fluid, its stable step `dt_fluid`, is sub-cycled between contact passes
+    /// ([`Scene::fluid_steps_per_pass`] > 1) against a solid whose cells a particle outweighs more than
+    /// [`SUBSTEP_RATIO`] times.
+    pub fn fluid_substeps_warning(&self, dt_fluid: f64) -> Option<String> {
+        let k = self.fluid_steps_per_pass(dt_fluid);
+        let (name, ratio) = self
+            .particle_to_cell_mass()
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        (k > 1 && ratio > SUBSTEP_RATIO).then(|| {
+            format!(
+                "coupling.fluid_substeps = {} against solid `{name}`, whose cells a fluid particle outweighs {ratio:.1} \
+                 times (above {SUBSTEP_RATIO:.0}): a contact pass every {k} fluid steps rings a mesh that fine (the 4 mm \
+                 gate, 14.5 cells, gained 0.05-0.08 of the water's releasable energy at 2-4 against 0.0014 in lockstep); \
+                 set coupling.fluid_substeps = 1 (docs/CORRECTIONS.md)",
+                self.coupling.fluid_substeps
+            )
+        })
     }
 
     /// With ISPH, a coupling step of `coupling_dt` spanning `fem_steps` FE steps of `fem_dt` each: a warning where it
@@ -138,6 +166,28 @@ mod tests {
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
         assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
+        // The fluid sub-cycled between passes: the 4 mm gate's 14.5 cells warn where 2 or more of its fluid steps
+        // (6.5e-5 s) fit under max_dt, not under the shipped 1e-4 (1.5 steps), not in lockstep, not with ISPH (which
+        // keeps the lockstep); the shipped 2 mm gate's 3.6 cells do not.
+        let dt = 6.5e-5;
+        let long = |k: &str| gate(&[k, "coupling.max_dt=2.5e-4"]);
+        let w = long("coupling.fluid_substeps=4").fluid_substeps_warning(dt).unwrap();
+        assert!(
+            w.starts_with(
+                "coupling.fluid_substeps = 4 against solid `gate`, whose cells a fluid particle outweighs 14.5 times \
+                 (above 4): a contact pass every 3 fluid steps"
+            ),
+            "{w}"
+        );
+        assert_eq!(long("coupling.fluid_substeps=4").fluid_steps_per_pass(dt), 3);
+        assert!(gate(&[]).fluid_substeps_warning(dt).is_none());
+        assert!(long("coupling.fluid_substeps=1").fluid_substeps_warning(dt).is_none());
+        assert!(gate(&["fluid.solver=\"isph\"", "coupling.max_dt=2.5e-4"])
+            .fluid_substeps_warning(dt)
+            .is_none());
+        assert!(gate(&["fluid.spacing=0.002"])
+            .fluid_substeps_warning(dt / 2.0)
+            .is_none());
         // The coupling step's length in FE steps: with ISPH only, from 32 FE steps, and naming 24 of them.
         // Without the bound from the structure's speed, which the default sets (`coupling.structure_courant`).
         let isph = gate(&["fluid.solver=\"isph\"", "coupling.structure_courant=0"]);

@@ -4,7 +4,7 @@
 use std::collections::HashSet;
 
 use super::schema::{
-    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec,
+    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, FLUID_SUBSTEPS_MAX,
     ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION,
 };
 use super::sizing::Sizing;
@@ -241,6 +241,16 @@ impl Scene {
                 format!(
                     "must be in [0, 1] (0: no bound from the structure's speed), got {}",
                     self.coupling.structure_courant
+                )
+            },
+        )?;
+        check(
+            (1..=FLUID_SUBSTEPS_MAX).contains(&self.coupling.fluid_substeps),
+            || "coupling.fluid_substeps".into(),
+            || {
+                format!(
+                    "must be a whole number in [1, {FLUID_SUBSTEPS_MAX}] (1: a contact pass after every fluid step), got {}",
+                    self.coupling.fluid_substeps
                 )
             },
         )?;

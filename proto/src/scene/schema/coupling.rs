@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::{ContactAlgorithm, FluidSolver, Scene};
+
 /// `[coupling]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -26,6 +28,32 @@ pub struct CouplingSpec {
         skip_serializing_if = "is_default_structure_courant"
     )]
     pub structure_courant: f64,
+    /// How many of the fluid's own stable steps one coupling step may span, with WCSPH and the `particle_element`
+    /// contact (the fluid node sub-cycles through them, as the structure node does through its FE steps): the
+    /// coupling step is then at most `fluid_substeps` − 0.05 of the fluid's last stable steps, rounded down to whole
+    /// steps where `max_dt` or the structure's Courant bound caps it. 1 is the paper's lockstep, a contact pass after
+    /// every fluid step (Long et al. 2016); larger values exchange and run the contact pass less often
+    /// (docs/CORRECTIONS.md "The fluid sub-cycled between contact passes"). ISPH and `particle_particle` keep the
+    /// lockstep. In [1, [`FLUID_SUBSTEPS_MAX`]]; default 1; not written to `scene.toml` at its default.
+    #[serde(
+        default = "default_fluid_substeps",
+        skip_serializing_if = "is_default_fluid_substeps"
+    )]
+    pub fluid_substeps: u32,
+}
+
+/// The most fluid steps a coupling step may span: the largest measured (docs/CORRECTIONS.md "The fluid sub-cycled
+/// between contact passes"). A WCSPH step moves a particle 0.25 h v / (c0 + v), at most 0.023 h at the Mach number 0.1
+/// WCSPH is run at (c0 ≥ 10 v_max, DESIGN.md §4.2): four of them 0.09 h, well inside what the contact catches behind
+/// a face (d_max = 2 Δx = 1.5 h).
+pub const FLUID_SUBSTEPS_MAX: u32 = 4;
+
+fn default_fluid_substeps() -> u32 {
+    1
+}
+
+fn is_default_fluid_substeps(k: &u32) -> bool {
+    *k == 1
 }
 
 /// The default of `coupling.structure_courant`: the largest of those measured (0.2, 0.1, 0.05) at which the ISPH
@@ -59,6 +87,44 @@ impl Default for CouplingSpec {
             fem_cfl: default_fem_cfl(),
             step_timeout: default_step_timeout(),
             structure_courant: default_structure_courant(),
+            fluid_substeps: default_fluid_substeps(),
+        }
+    }
+}
+
+/// How much of a fluid step a coupling step of several leaves out (`contact-broker` `Clock::fluid_span`). The fluid
+/// node sub-cycles at its own stable step, full steps and a remainder (WCSPH), and its stable step shrinks a little
+/// from one sub-step to the next as the flow speeds up; a coupling step of exactly k last-reported steps then took k
+/// full steps and a remainder of a few ulps to a few per cent of one in most coupling steps (the shipped gate at
+/// k = 4: 16,035 fluid steps against 13,479 in lockstep). n − 0.05 steps leave the last sub-step to absorb a shrink
+/// of up to 1.2 % a step.
+pub const SUBSTEP_SLACK: f64 = 0.05;
+
+impl Scene {
+    /// How many fluid steps of `dt_fluid` a coupling step spans at most: [`Scene::fluid_substeps`], fewer where
+    /// `coupling.max_dt` holds fewer whole ones (n − [`SUBSTEP_SLACK`] of them), at least 1.
+    pub fn fluid_steps_per_pass(&self, dt_fluid: f64) -> u32 {
+        let fit = (self.coupling.max_dt / dt_fluid + SUBSTEP_SLACK).floor();
+        if fit.is_finite() && fit >= 1.0 {
+            self.fluid_substeps().min(fit as u32)
+        } else {
+            1
+        }
+    }
+
+    /// How many of the fluid's last stable steps one coupling step may span: `coupling.fluid_substeps` with WCSPH and
+    /// the particle–element contact, 1 (the paper's lockstep) otherwise. The contact corrects at each coupling step's
+    /// end whatever the step made penetrate, however many fluid steps it spans (the fluid node sub-cycles through
+    /// them), and a WCSPH step is set by the sound speed: its particles move 0.25 h v / (c0 + v), a fortieth of h at
+    /// the Mach numbers WCSPH is run at, where the contact needs a pass every few hundredths of h. ISPH's own step
+    /// already moves its fastest particle a quarter of h (DESIGN.md §4.3); `particle_particle` acts as a force, once a
+    /// coupling step, which a longer step would coarsen.
+    pub fn fluid_substeps(&self) -> u32 {
+        match (&self.fluid, self.contact.algorithm) {
+            (Some(f), ContactAlgorithm::ParticleElement) if f.solver == FluidSolver::Wcsph => {
+                self.coupling.fluid_substeps
+            }
+            _ => 1,
         }
     }
 }

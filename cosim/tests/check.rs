@@ -1,0 +1,187 @@
+//! `cosim check`: what it prints of a scene before anything runs — sizes, the coupling step it estimates, the
+//! corrections in force — and the warnings it (and `cosim run`) gives of a coupling that will gain energy.
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+
+#[test]
+fn check_prints_what_would_run() {
+    let out = cosim_run(
+        &["check", root().join("scenes/csm3.toml").to_str().unwrap(), "--json"],
+        Duration::from_secs(30),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fem_nodes"].as_u64().unwrap(), 355);
+    assert_eq!(doc["fem_elements"].as_u64().unwrap(), 280);
+    assert_eq!(doc["coupling_steps"].as_u64().unwrap(), 5000);
+    assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
+}
+
+/// `cosim check SCENE --json --set …` from the workspace root, its document (fails the test unless it succeeds).
+fn check_json(scene: &str, sets: &[&str]) -> serde_json::Value {
+    let path = root().join(scene);
+    let mut args = vec!["check", path.to_str().unwrap(), "--json"];
+    for set in sets {
+        args.extend_from_slice(&["--set", set]);
+    }
+    let out = cosim_run(&args, Duration::from_secs(30));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `cosim check` says where the coupling step will be shorter than its estimate: WCSPH with `particle_particle`,
+/// whose stiff force bounds it as the run goes (contact-broker/src/contact_step.rs), not `particle_element` nor ISPH.
+#[test]
+fn check_says_when_the_contact_bounds_the_step() {
+    let bounded =
+        |extra: &[&str]| check_json("scenes/elastic_gate.toml", extra)["coupling_dt_bounded_by_contact"].clone();
+    assert_eq!(bounded(&[]), false);
+    assert_eq!(bounded(&["contact.algorithm=particle_particle"]), true);
+    assert_eq!(
+        bounded(&["contact.algorithm=particle_particle", "fluid.solver=isph"]),
+        false
+    );
+}
+
+/// `cosim check` estimates the coupling step as the broker fixes it: the fluid's stable step in lockstep (the
+/// default), `coupling.fluid_substeps` − 0.05 of them with WCSPH and `particle_element`, rounded down to whole fluid
+/// steps under `coupling.max_dt`; the lockstep again with `particle_particle` or ISPH.
+#[test]
+fn check_estimates_the_coupling_step_over_the_fluid_substeps() {
+    let step = |extra: &[&str]| {
+        let doc = check_json("scenes/elastic_gate.toml", extra);
+        let (dt, fluid) = (
+            doc["coupling_dt"].as_f64().unwrap(),
+            doc["sph_dt_stable"].as_f64().unwrap(),
+        );
+        (dt / fluid, doc["coupling_fluid_steps_per_pass"].clone())
+    };
+    let lockstep = step(&["coupling.fluid_substeps=1"]);
+    assert_eq!(lockstep, (1.0, serde_json::json!(1)));
+    // The gate's fluid step is ~3e-5 s: 4 of them fit under a max_dt of 2e-4 s, 3 under 1e-4 s (3.3 steps).
+    let (span, k) = step(&["coupling.fluid_substeps=4", "coupling.max_dt=2e-4"]);
+    assert!((span - 3.95).abs() < 1e-12 && k == 4, "{span} {k}");
+    let (span, k) = step(&["coupling.fluid_substeps=4", "coupling.max_dt=1e-4"]);
+    assert!((span - 2.95).abs() < 1e-12 && k == 3, "{span} {k}");
+    let pp = step(&[
+        "coupling.fluid_substeps=4",
+        "coupling.max_dt=2e-4",
+        "contact.algorithm=particle_particle",
+    ]);
+    assert_eq!(pp, (1.0, serde_json::json!(1)));
+}
+
+/// `cosim check` says how many mesh cells of each solid a fluid particle weighs (ρ Δx² / (ρ_s w h / (nx ny))): the
+/// shipped gate's 2 mm particles 3.64 of its 1 mm cells, no warning; 4 mm particles against cells half as wide, 58.2,
+/// over the bound of 30, and both `check` and `run` warn, naming the solid (docs/CORRECTIONS.md "The structure's mesh
+/// against the fluid's particles": that gate gains 0.106 of its budget with WCSPH); and, with the fluid sub-cycled
+/// between contact passes (the scene's `coupling.fluid_substeps`), that a pass every few fluid steps rings it.
+#[test]
+fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
+    let check = |extra: &[&str]| check_json("scenes/elastic_gate.toml", extra);
+    let shipped = check(&[]);
+    let ratio = shipped["particle_to_cell_mass"]["gate"].as_f64().unwrap();
+    assert!((ratio - 4.0 / 1.1).abs() < 1e-9, "{shipped}");
+    assert_eq!(shipped["warnings"], serde_json::json!([]));
+    let fine = ["fluid.spacing=0.004", "solid[0].divisions=[10,158]"];
+    let doc = check(&fine);
+    let ratio = doc["particle_to_cell_mass"]["gate"].as_f64().unwrap();
+    assert!((ratio - 64.0 / 1.1).abs() < 1e-9, "{doc}");
+    let warnings = doc["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{doc}");
+    assert!(
+        warnings[0].as_str().unwrap().contains("58 cells of solid `gate`"),
+        "{doc}"
+    );
+    // With a max_dt that holds 3 of its fluid steps the scene's coupling.fluid_substeps = 4 sub-cycles the fluid: a
+    // contact pass every 3 fluid steps against that mesh is warned of too; not in lockstep.
+    let long = check(&[fine[0], fine[1], "coupling.max_dt=2.5e-4"]);
+    let warnings = long["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 2, "{long}");
+    assert!(
+        warnings[1].as_str().unwrap().starts_with(
+            "coupling.fluid_substeps = 4 against solid `gate`, whose cells a fluid particle outweighs 58.2 times \
+             (above 4): a contact pass every 3 fluid steps"
+        ),
+        "{long}"
+    );
+    let lockstep = check(&[fine[0], fine[1], "coupling.max_dt=2.5e-4", "coupling.fluid_substeps=1"]);
+    assert_eq!(lockstep["warnings"].as_array().unwrap().len(), 1, "{lockstep}");
+    let dir = scratch("heavy-particle");
+    let out = dir.join("out");
+    let mut args = vec![
+        "run",
+        "scenes/elastic_gate.toml",
+        "--in-process",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    for set in fine
+        .iter()
+        .chain(&["run.end_time=0.0005", "run.output_interval=0.0005"])
+    {
+        args.extend_from_slice(&["--set", set]);
+    }
+    let run = run_ok(&args);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("cosim: warning: a fluid particle weighs 58 cells of solid `gate`"),
+        "{stderr}"
+    );
+}
+
+/// `cosim check` warns where, with ISPH, a coupling step spans many of the structure's FE steps against a mesh that a
+/// particle outweighs and the structure's speed does not bound the step: the shipped gate left at the default
+/// `coupling.max_dt` (1e-3: ISPH's own step, 76 FE steps) with `coupling.structure_courant = 0`, not at its own 1e-4
+/// (25), nor with the bound (the default), nor the hydrostatic plate (78 FE steps, a particle of 1.5 cells), nor WCSPH.
+#[test]
+fn check_warns_of_an_isph_coupling_step_spanning_many_fe_steps() {
+    let warnings = |scene: &str, extra: &[&str]| check_json(scene, extra)["warnings"].as_array().unwrap().clone();
+    let isph = "fluid.solver=isph";
+    let unbounded = "coupling.structure_courant=0";
+    assert!(warnings("scenes/elastic_gate.toml", &[isph, "coupling.max_dt=1e-3"]).is_empty());
+    let w = warnings("scenes/elastic_gate.toml", &[isph, "coupling.max_dt=1e-3", unbounded]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    let w = w[0].as_str().unwrap();
+    assert!(
+        w.contains("spans 76 FE steps") && w.contains("try coupling.max_dt = 1e-4"),
+        "{w}"
+    );
+    assert!(warnings("scenes/elastic_gate.toml", &[isph]).is_empty());
+    assert!(warnings("scenes/elastic_gate.toml", &["coupling.max_dt=1e-3"]).is_empty());
+    assert!(warnings("scenes/hydrostatic_plate.toml", &[isph]).is_empty());
+}
+
+/// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
+/// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
+#[test]
+fn check_names_the_corrections_in_force() {
+    let dam = root().join("scenes/dam_break.toml");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", dam.to_str().unwrap(), "--json"];
+        args.extend_from_slice(extra);
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["corrections"].clone()
+    };
+    let wcsph = check(&[]);
+    assert_eq!(wcsph["density_filter"], "shepard", "{wcsph}");
+    assert_eq!(wcsph["density_filter_interval"], 20, "{wcsph}");
+    assert_eq!(wcsph["xsph"], 0.5, "{wcsph}");
+    assert_eq!(wcsph["apd"], 0.04, "{wcsph}");
+    let isph = check(&["--set", "fluid.solver=isph"]);
+    assert_eq!(isph["density_filter"], "none", "{isph}");
+    assert_eq!(isph["apd"], 0.04, "{isph}");
+    assert_eq!(check(&["--set", "fluid.apd=0"])["apd"], 0.0);
+    let csm3 = cosim_run(
+        &["check", root().join("scenes/csm3.toml").to_str().unwrap(), "--json"],
+        Duration::from_secs(30),
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&csm3.stdout).unwrap();
+    assert!(doc["corrections"].is_null(), "a scene without fluid: {doc}");
+}
