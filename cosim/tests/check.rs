@@ -97,14 +97,14 @@ fn check_and_run_warn_of_a_mesh_much_finer_than_the_fluid() {
         warnings[0].as_str().unwrap().contains("58 cells of solid `gate`"),
         "{doc}"
     );
-    // With a max_dt that holds 3 of its fluid steps the scene's coupling.fluid_substeps = 4 sub-cycles the fluid: a
+    // With a max_dt that holds 3 of its fluid steps the scene's coupling.fluid_substeps = 8 sub-cycles the fluid: a
     // contact pass every 3 fluid steps against that mesh is warned of too; not in lockstep.
     let long = check(&[fine[0], fine[1], "coupling.max_dt=2.5e-4"]);
     let warnings = long["warnings"].as_array().unwrap();
     assert_eq!(warnings.len(), 2, "{long}");
     assert!(
         warnings[1].as_str().unwrap().starts_with(
-            "coupling.fluid_substeps = 4 against solid `gate`, whose cells a fluid particle outweighs 58.2 times \
+            "coupling.fluid_substeps = 8 against solid `gate`, whose cells a fluid particle outweighs 58.2 times \
              (above 4): a contact pass every 3 fluid steps"
         ),
         "{long}"

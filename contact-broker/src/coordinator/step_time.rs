@@ -260,8 +260,8 @@ mod tests {
             clock.next_step().dt
         };
         assert_eq!(first(&["coupling.fluid_substeps=1"]), 1e-5);
-        // The shipped gate takes 4.
-        assert_eq!(first(&[]), (4.0 - SUBSTEP_SLACK) * 1e-5);
+        // The shipped gate takes 8.
+        assert_eq!(first(&[]), (8.0 - SUBSTEP_SLACK) * 1e-5);
         assert_eq!(first(&["coupling.fluid_substeps=3"]), (3.0 - SUBSTEP_SLACK) * 1e-5);
         assert_eq!(first(&["coupling.fluid_substeps=4"]), (4.0 - SUBSTEP_SLACK) * 1e-5);
         // particle_particle acts as a force once a coupling step, ISPH's own step is long: the paper's lockstep
