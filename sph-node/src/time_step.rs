@@ -20,5 +20,5 @@ pub fn stable_dt(h: f64, c0: f64, v_max: f64, a_max: f64, nu: f64) -> f64 {
 /// (no gravity and no `fluid.sound_speed`).
 pub fn at_rest(spec: &cosim_proto::scene::FluidSpec, gravity: [f64; 2]) -> Option<f64> {
     let c0 = crate::setup::sound_speed(spec, gravity).ok()?;
-    Some(spec.cfl * 0.25 * spec.smoothing_ratio * spec.spacing / c0)
+    Some(spec.cfl * stable_dt(spec.smoothing_ratio * spec.spacing, c0, 0.0, 0.0, 0.0))
 }

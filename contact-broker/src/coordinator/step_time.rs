@@ -1,7 +1,7 @@
 //! The run's clock (`DESIGN.md` §3 step 1): how long each coupling step is, and the output times the steps land
 //! on.
 
-use cosim_proto::scene::{ContactAlgorithm, Scene, SUBSTEP_SLACK};
+use cosim_proto::scene::{whole_fluid_steps, ContactAlgorithm, Scene, SUBSTEP_SLACK};
 
 use super::exchange::Round;
 use crate::summary::Summary;
@@ -27,7 +27,7 @@ pub(super) struct Clock {
     /// `coupling.structure_courant` · h: how far the structure's surface may move in one step [m] (0: no bound).
     reach: f64,
     /// How many of the fluid's stable steps a coupling step may span ([`Scene::fluid_substeps`]).
-    fluid_substeps: f64,
+    fluid_substeps: u32,
     interval: f64,
     end: f64,
     max_dt: f64,
@@ -78,7 +78,7 @@ impl Clock {
             dt_contact: f64::INFINITY,
             dt_structure: f64::INFINITY,
             reach: structure_reach(scene),
-            fluid_substeps: f64::from(scene.fluid_substeps()),
+            fluid_substeps: scene.fluid_substeps(),
             interval: scene.run.output_interval,
             end: scene.run.end_time,
             max_dt: scene.coupling.max_dt,
@@ -121,9 +121,9 @@ impl Clock {
     /// fluid steps, n the most of them, up to k, that fit in the cap (a cap of 3.3 steps gives 2.95, which the fluid
     /// takes in 3 sub-steps, where 3.3 would take 4).
     fn fluid_span(&self, cap: f64) -> f64 {
-        let whole = (cap / self.dt_fluid + SUBSTEP_SLACK).floor().min(self.fluid_substeps);
-        if whole >= 2.0 {
-            (whole - SUBSTEP_SLACK) * self.dt_fluid
+        let whole = whole_fluid_steps(cap, self.dt_fluid, self.fluid_substeps);
+        if whole >= 2 {
+            (f64::from(whole) - SUBSTEP_SLACK) * self.dt_fluid
         } else {
             cap.min(self.dt_fluid)
         }

@@ -83,10 +83,7 @@ impl Scene {
     /// [`SUBSTEP_RATIO`] times.
     pub fn fluid_substeps_warning(&self, dt_fluid: f64) -> Option<String> {
         let k = self.fluid_steps_per_pass(dt_fluid);
-        let (name, ratio) = self
-            .particle_to_cell_mass()
-            .into_iter()
-            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        let (name, ratio) = self.heaviest_particle()?;
         (k > 1 && ratio > SUBSTEP_RATIO).then(|| {
             format!(
                 "coupling.fluid_substeps = {} against solid `{name}`, whose cells a fluid particle outweighs {ratio:.1} \
@@ -108,10 +105,7 @@ impl Scene {
         let bounded =
             self.coupling.structure_courant > 0.0 && self.contact.algorithm == ContactAlgorithm::ParticleElement;
         let isph = self.fluid.as_ref()?.solver == FluidSolver::Isph && !bounded;
-        let (name, ratio) = self
-            .particle_to_cell_mass()
-            .into_iter()
-            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        let (name, ratio) = self.heaviest_particle()?;
         (isph && ratio >= LONG_STEP_RATIO && fem_steps >= LONG_COUPLING_STEP).then(|| {
             format!(
                 "with ISPH the coupling step ({coupling_dt:.2e} s) spans {fem_steps} FE steps of the structure, and a \
@@ -129,6 +123,13 @@ impl Scene {
                 }
             )
         })
+    }
+
+    /// The solid whose cells a fluid particle outweighs most, and by how much ([`Scene::particle_to_cell_mass`]).
+    fn heaviest_particle(&self) -> Option<(&str, f64)> {
+        self.particle_to_cell_mass()
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// `solid[i]`, the key of the solid named `name`.

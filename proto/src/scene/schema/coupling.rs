@@ -100,16 +100,23 @@ impl Default for CouplingSpec {
 /// of up to 1.2 % a step.
 pub const SUBSTEP_SLACK: f64 = 0.05;
 
+/// How many whole fluid steps of `dt_fluid` a coupling step within `cap` spans: the most n, up to `most`, whose
+/// n − [`SUBSTEP_SLACK`] steps fit in the cap; at least 1. The rule of the broker's clock (`Clock::fluid_span`) and of
+/// what `cosim check` and `cosim run` say of it.
+pub fn whole_fluid_steps(cap: f64, dt_fluid: f64, most: u32) -> u32 {
+    let whole = (cap / dt_fluid + SUBSTEP_SLACK).floor().min(f64::from(most));
+    if whole >= 1.0 {
+        whole as u32
+    } else {
+        1
+    }
+}
+
 impl Scene {
     /// How many fluid steps of `dt_fluid` a coupling step spans at most: [`Scene::fluid_substeps`], fewer where
-    /// `coupling.max_dt` holds fewer whole ones (n − [`SUBSTEP_SLACK`] of them), at least 1.
+    /// `coupling.max_dt` holds fewer whole ones ([`whole_fluid_steps`]).
     pub fn fluid_steps_per_pass(&self, dt_fluid: f64) -> u32 {
-        let fit = (self.coupling.max_dt / dt_fluid + SUBSTEP_SLACK).floor();
-        if fit.is_finite() && fit >= 1.0 {
-            self.fluid_substeps().min(fit as u32)
-        } else {
-            1
-        }
+        whole_fluid_steps(self.coupling.max_dt, dt_fluid, self.fluid_substeps())
     }
 
     /// How many of the fluid's last stable steps one coupling step may span: `coupling.fluid_substeps` with WCSPH and
