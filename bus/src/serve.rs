@@ -375,19 +375,16 @@ fn serve_session<C: NodeCore>(
 }
 
 /// The state to restart from, when the broker has one for this node (`docs/PROTOCOL.md` §9): `None` for a run
-/// that starts from the scene.
+/// that starts from the scene. Asked again while nobody answers ([`crate::ask`]): the broker declares this
+/// queryable after the scene's, and a link lost and restored takes it away for a moment.
 fn fetch_restore(
     session: &Session,
     run: &str,
     topics: NodeTopics,
     timeout: Duration,
 ) -> anyhow::Result<Option<Envelope<NodeCheckpoint>>> {
-    let replies = session
-        .get(key(run, topics.restore))
-        .timeout(timeout)
-        .wait()
-        .map_err(zerr)?;
-    let Ok(reply) = replies.recv() else {
+    let answers = crate::ask::ask(session, &key(run, topics.restore), timeout).map_err(zerr)?;
+    let Some(reply) = answers.into_iter().next() else {
         anyhow::bail!(
             "the broker of run {run} did not answer {} within {:.0} s",
             topics.restore,
@@ -407,32 +404,14 @@ fn fetch_restore(
     Ok((!env.body.data.is_empty()).then_some(env))
 }
 
-/// The scene from the run's broker. Every answer is collected (consolidation off: zenoh would otherwise keep one
-/// answer per key), and a run answered by more than one broker is refused ([`crate::claim::Ambiguous`]): two runs
-/// on one run id that started within the moment the brokers' own check cannot see.
-///
-/// Asked again every [`SCENE_RETRY`] until `timeout` while nobody answers: a query that finds no queryable ends at
-/// once with no answer, and a node started as soon as its broker's session was open can ask through a router that
-/// has not yet heard of the broker's queryable (seen over TLS: both nodes gave up within a second, CI of
-/// 2026-11-28, eighth).
+/// The scene from the run's broker. Every answer is collected, and a run answered by more than one broker is
+/// refused ([`crate::claim::Ambiguous`]): two runs on one run id that started within the moment the brokers' own
+/// check cannot see. Asked again while nobody answers ([`crate::ask`]): a node started as soon as its broker's
+/// session was open can ask through a router that has not yet heard of the broker's queryable (seen over TLS: both
+/// nodes gave up within a second, CI of 2026-11-28, eighth).
 fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Result<String> {
     let scene_key = key(run, topic::SCENE);
-    let deadline = std::time::Instant::now() + timeout;
-    let answers = loop {
-        let left = deadline.saturating_duration_since(std::time::Instant::now());
-        let replies = session
-            .get(&scene_key)
-            .consolidation(zenoh::query::ConsolidationMode::None)
-            .timeout(left.max(SCENE_RETRY))
-            .wait()
-            .map_err(zerr)?;
-        // The channel closes once every queryable answered (or at the timeout).
-        let answers: Vec<_> = std::iter::from_fn(|| replies.recv().ok()).collect();
-        if !answers.is_empty() || std::time::Instant::now() + SCENE_RETRY >= deadline {
-            break answers;
-        }
-        std::thread::sleep(SCENE_RETRY);
-    };
+    let answers = crate::ask::ask(session, &scene_key, timeout).map_err(zerr)?;
     if answers.len() > 1 {
         return Err(crate::claim::Ambiguous {
             run: run.into(),
@@ -452,6 +431,3 @@ fn fetch_scene(session: &Session, run: &str, timeout: Duration) -> anyhow::Resul
         ),
     }
 }
-
-/// How often a node asks again for the scene while no broker answers ([`fetch_scene`]).
-const SCENE_RETRY: Duration = Duration::from_millis(200);

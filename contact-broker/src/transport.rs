@@ -320,13 +320,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
         let what = self.topics.checkpoint;
-        let replies = self
-            .session
-            .get(key(&self.run, what))
-            .timeout(self.step_timeout)
-            .wait()
+        // Asked again while nobody answers: a link lost and restored takes the node's queryable away for a moment.
+        let answers = cosim_bus::ask::ask(&self.session, &key(&self.run, what), self.step_timeout)
             .map_err(|e| self.failed(format!("cannot ask for a checkpoint: {e}")))?;
-        let reply = replies.recv().map_err(|_| {
+        let reply = answers.into_iter().next().ok_or_else(|| {
             self.failed(format!(
                 "did not answer {what} within {:.0} s (an outside program in a node's place may not save checkpoints)",
                 self.step_timeout.as_secs_f64()

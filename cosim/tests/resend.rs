@@ -7,6 +7,9 @@
 //!   byte-identical to the same scene in one process.
 //! - `a_node_answers_a_repeated_command_again`: a broker written here sends `fem-node` the command of step 0
 //!   twice, and gets the same answer twice, byte for byte; the next step then runs as usual.
+//! - `a_node_asks_again_while_nobody_answers_its_query`: a query that finds nobody to answer it yet ends at once
+//!   in zenoh (a router that has not heard of the queryable, a link lost and restored): a broker written here
+//!   declares the `restore` queryable only 0.5 s after `fem-node` got the scene, and the node still registers.
 
 mod common;
 
@@ -208,4 +211,88 @@ fn a_node_answers_a_repeated_command_again() {
     let status = wait_exit(&mut node.0, Instant::now() + LIMIT, "fem-node");
     assert!(status.success());
     assert!(states.try_recv().unwrap().is_none(), "nothing after the stop");
+}
+
+#[test]
+fn a_node_asks_again_while_nobody_answers_its_query() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    let id = run_id("ask-again");
+    let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+    let s = session(std::slice::from_ref(&endpoint), &[]);
+    let text = cosim_proto::scene::load(std::path::Path::new(&scene_path()), &[])
+        .unwrap()
+        .scene
+        .to_toml();
+    let scenes_served = Arc::new(AtomicUsize::new(0));
+    let served = scenes_served.clone();
+    let _scene = s
+        .declare_queryable(key(&id, topic::SCENE))
+        .callback(move |q| {
+            q.reply(q.key_expr().clone(), text.clone()).wait().unwrap();
+            served.fetch_add(1, Ordering::SeqCst);
+        })
+        .wait()
+        .unwrap();
+    let _alive = s
+        .liveliness()
+        .declare_token(key(&id, topic::BROKER_ALIVE))
+        .wait()
+        .unwrap();
+    let mesh = s.declare_subscriber(key(&id, topic::FEM_MESH)).wait().unwrap();
+    let mut node = Kill(
+        Command::new(program("fem-node"))
+            .args(["--run", &id, "--connect", &endpoint])
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let started = Instant::now();
+    while scenes_served.load(Ordering::SeqCst) == 0 {
+        assert!(started.elapsed() < LIMIT, "the node never asked for the scene");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // The node asks for its restart state right after the scene, and finds nobody to answer.
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        node.0.try_wait().unwrap().is_none(),
+        "the node gave up on a query nobody could answer yet"
+    );
+    let asked = Arc::new(AtomicUsize::new(0));
+    let counted = asked.clone();
+    let run = id.clone();
+    let _restore = s
+        .declare_queryable(key(&id, topic::FEM_RESTORE))
+        .callback(move |q| {
+            let none = NodeCheckpoint {
+                node: "fem-node".into(),
+                data: Vec::new(),
+            };
+            q.reply(q.key_expr().clone(), Envelope::new(&run, 0, 0.0, none).encode())
+                .wait()
+                .unwrap();
+            counted.fetch_add(1, Ordering::SeqCst);
+        })
+        .wait()
+        .unwrap();
+    let registered = mesh.recv_timeout(LIMIT).unwrap();
+    if registered.is_none() {
+        node.0.kill().unwrap();
+        let mut log = String::new();
+        std::io::Read::read_to_string(&mut node.0.stderr.take().unwrap(), &mut log).unwrap();
+        panic!("the node did not register: {log}");
+    }
+    assert_eq!(
+        asked.load(Ordering::SeqCst),
+        1,
+        "one answered query for the restart state"
+    );
+    let stop = StepCommand::bare_stop();
+    s.put(key(&id, topic::BROKER_FEM), Envelope::new(&id, 0, 0.0, stop).encode())
+        .wait()
+        .unwrap();
+    let status = wait_exit(&mut node.0, Instant::now() + LIMIT, "fem-node");
+    assert!(status.success());
 }

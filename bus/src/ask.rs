@@ -1,0 +1,40 @@
+//! A query asked again while nobody can answer it yet. A zenoh `get` that finds no queryable for its key ends at
+//! once with no answer; it does not wait for one to appear. So a query made while the answering side's declaration
+//! is still on its way — a node started as soon as its broker's session was open, asking through a router that has
+//! not heard of the broker's queryable yet (seen over TLS, CI of 2026-11-28), or a link lost and restored, which
+//! takes every declaration seen through it away until zenoh declares it again (`crate::link_loss`; seen in a local
+//! suite run of 2026-12-06: a node's `restore` query got no answer at start-up and the run failed) — would read
+//! "nobody answers" where someone will within moments. [`ask`] asks again every [`RETRY`] until its timeout
+//! while no answer came. The keys asked this way are answered by every process that serves them, so asking twice
+//! changes nothing.
+
+use std::time::{Duration, Instant};
+
+use zenoh::query::{ConsolidationMode, Reply};
+use zenoh::{Session, Wait};
+
+/// How often a query is asked again while nobody answers it.
+pub const RETRY: Duration = Duration::from_millis(200);
+
+/// Every answer to a `get` on `key`, asked again every [`RETRY`] while none came, for at most `timeout` in all: an
+/// empty list means nobody answered within `timeout`. Every answer is kept (consolidation off: zenoh would
+/// otherwise keep one answer per key, and a caller may need to know that two processes answered).
+pub fn ask(session: &Session, key: &str, timeout: Duration) -> zenoh::Result<Vec<Reply>> {
+    let deadline = Instant::now() + timeout;
+    loop {
+        let asked = Instant::now();
+        let left = deadline.saturating_duration_since(asked);
+        let replies = session
+            .get(key)
+            .consolidation(ConsolidationMode::None)
+            .timeout(left.max(RETRY))
+            .wait()?;
+        // The channel closes once every queryable answered (or at the timeout).
+        let answers: Vec<Reply> = std::iter::from_fn(|| replies.recv().ok()).collect();
+        if !answers.is_empty() || Instant::now() + RETRY >= deadline {
+            return Ok(answers);
+        }
+        // A query that found nobody returns at once: do not spin.
+        std::thread::sleep(RETRY.saturating_sub(asked.elapsed()));
+    }
+}
