@@ -19,5 +19,6 @@ pub mod recorder;
 pub mod relaxation;
 pub mod remote_control;
 pub mod setup;
+pub mod step_budget;
 pub mod summary;
 pub mod transport;

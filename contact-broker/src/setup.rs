@@ -30,6 +30,11 @@ impl RunSetup {
         let scene = cosim_proto::scene::load(file, set)?;
         let name = file.display().to_string();
         cosim_bus::memory::refuse_above(&scene.scene, part, &name, cosim_bus::memory::available())?;
+        crate::step_budget::refuse_endless(&scene.scene).map_err(|(key, message)| cosim_proto::scene::SceneError {
+            file: name.clone(),
+            key,
+            message,
+        })?;
         Ok(Self {
             scene,
             checkpoint_interval: None,

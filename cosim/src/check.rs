@@ -19,6 +19,11 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let sizing = Sizing::of(s);
     let available = memory::available();
     memory::refuse_above(s, Part::Run, &args.scene.display().to_string(), available)?;
+    contact_broker::step_budget::refuse_endless(s).map_err(|(key, message)| scene::SceneError {
+        file: args.scene.display().to_string(),
+        key,
+        message,
+    })?;
     let (dt_fem, nodes, elements) = if s.solids.is_empty() {
         (None, 0, 0)
     } else {

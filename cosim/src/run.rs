@@ -182,8 +182,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             // A structure whose surface moves a large part of h between two contact passes (docs/CORRECTIONS.md
             // "The coupling step bounded by the structure's speed").
             let c = scene.scene.coupling.structure_courant;
-            if !scene.scene.solids.is_empty() && scene.scene.fluid.is_some() {
-                let try_c = if c > 0.0 { 0.5 * c } else { STRUCTURE_COURANT_DEFAULT };
+            // (Halved down to the key's least value, 1e-3; at that value there is nothing shorter to suggest.)
+            if !scene.scene.solids.is_empty() && scene.scene.fluid.is_some() && (c == 0.0 || c > 1e-3) {
+                let try_c = if c > 0.0 {
+                    (0.5 * c).max(1e-3)
+                } else {
+                    STRUCTURE_COURANT_DEFAULT
+                };
                 eprintln!(
                     "cosim: so is a step bounded by the structure's speed, --set coupling.structure_courant={try_c} \
                      (now {c})"

@@ -1,7 +1,10 @@
 //! Scenes at the limits (issue 17, the scene side of the trust boundary): a scene too big for the run's ids or for
 //! this machine's memory, a million probes, non-finite numbers, overlapping solids and a scene with nothing to run
 //! are each refused by `cosim check` and `cosim run` within seconds, exit code 2, with one line naming the key and
-//! the value — before anything the size of the scene is allocated.
+//! the value — before anything the size of the scene is allocated. So is a run that needs more steps than any run
+//! can take (`contact_broker::step_budget`): found 2026-12-06, a viscosity of 1e300 m²/s held the fluid node in one
+//! coupling step that Ctrl-C could not end, and a `coupling.max_dt` of 1e-300 ran ~18,000 steps a second toward
+//! 1e301.
 
 mod common;
 
@@ -73,6 +76,25 @@ fn spacing_too_fine_for_u32_ids_is_refused_naming_the_spacing() {
         "scenes/dam_break.toml",
         &["fluid.spacing=1e-6"],
         &["dam_break.toml", "fluid.spacing", &format!("{}", 1e-6), "u32"],
+    );
+}
+
+#[test]
+fn a_run_that_could_never_end_is_refused_naming_the_key() {
+    both_refuse(
+        "scenes/csm3.toml",
+        &["coupling.max_dt=1e-300"],
+        &["coupling.max_dt", "1e-300 s", "1.00e301 coupling steps", "1e12"],
+    );
+    both_refuse(
+        "scenes/dam_break.toml",
+        &["fluid.kinematic_viscosity=1e300"],
+        &["fluid.kinematic_viscosity", "1e300 m²/s", "8.450e-307 s", "fluid steps", "1e12"],
+    );
+    both_refuse(
+        "scenes/elastic_gate.toml",
+        &["fluid.sound_speed=1e300"],
+        &["fluid.sound_speed", "1e300 m/s", "0.25 h/c0"],
     );
 }
 

@@ -9,7 +9,7 @@ use cosim_proto::messages::{ContactFace, Correction, SphSetup, SphSnapshot, SphS
 use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
 use serde::{Deserialize, Serialize};
 
-use crate::error::SphError;
+use crate::error::{SphError, MAX_SUBSTEPS};
 use crate::fluid_solver::{FluidSolver, SavedSolver};
 use crate::isph::IsphSolver;
 use crate::sensors::{IntervalSensors, PressureField, SensorLog};
@@ -225,12 +225,23 @@ impl SphCore {
             if dt - done - h <= 1e-9 * h {
                 h = dt - done;
             }
+            // A stable step that would take more than 2^32 sub-steps, or that no longer moves `done` (below its
+            // last bit), is a blow-up in the making: an error now, not a coupling step that never ends (which no
+            // Ctrl-C, answered between coupling steps, could stop).
+            let count = left / stable;
+            if count.is_nan() || count > MAX_SUBSTEPS || done + h <= done {
+                return Err(SphError::StepCollapsed {
+                    step: self.solver.state().step + 1,
+                    stable,
+                    left,
+                });
+            }
             self.solver.step(h)?;
             if !self.sensors.is_empty() {
                 self.sensors
                     .after_step(&pressure_field(self.solver.as_ref(), &self.setup), h);
             }
-            substeps += 1;
+            substeps = substeps.saturating_add(1);
             done += h;
         }
         Ok(substeps)

@@ -29,6 +29,22 @@ pub enum SphError {
         /// What went wrong.
         reason: String,
     },
+    /// The fluid's own stable step fell so far below what is left of the step asked of it that the sub-cycle would
+    /// take more than [`MAX_SUBSTEPS`] sub-steps, or no longer advance the time at all: a blow-up in the making (a
+    /// speed or an acceleration without bound), or numbers in the scene that allow no usable step, which `cosim
+    /// check` and `cosim run` name before a run starts.
+    #[error(
+        "unstable at SPH step {step}: the fluid's stable step fell to {stable:.3e} s, and the {left:.3e} s left of \
+         the coupling step would take more than 2^32 sub-steps of it"
+    )]
+    StepCollapsed {
+        /// Number of the step that was to be taken (`FluidState::step + 1`).
+        step: u64,
+        /// The solver's stable step at that point [s].
+        stable: f64,
+        /// What was left of the coupling step [s].
+        left: f64,
+    },
     /// The ISPH pressure Poisson equation did not converge (`DESIGN.md` §4.3).
     #[error("PPE not converged at SPH step {step}: relative residual {residual:e} after {iterations} iterations")]
     PpeNotConverged {
@@ -42,11 +58,14 @@ pub enum SphError {
 }
 
 impl SphError {
-    /// True for a numerical blow-up ([`SphError::Unstable`]).
+    /// True for a numerical blow-up ([`SphError::Unstable`], [`SphError::StepCollapsed`]).
     pub fn is_unstable(&self) -> bool {
-        matches!(self, SphError::Unstable { .. })
+        matches!(self, SphError::Unstable { .. } | SphError::StepCollapsed { .. })
     }
 }
+
+/// The most sub-steps one coupling step may take in the fluid node (2^32, as fem-node's sub-cycle).
+pub const MAX_SUBSTEPS: f64 = 4_294_967_296.0;
 
 /// `Result` with [`SphError`] by default.
 pub type Result<T, E = SphError> = std::result::Result<T, E>;

@@ -22,3 +22,30 @@ pub fn at_rest(spec: &cosim_proto::scene::FluidSpec, gravity: [f64; 2]) -> Optio
     let c0 = crate::setup::sound_speed(spec, gravity).ok()?;
     Some(spec.cfl * stable_dt(spec.smoothing_ratio * spec.spacing, c0, 0.0, 0.0, 0.0))
 }
+
+/// The longest step a scene's fluid can take whatever its motion, and the key of the condition that sets it: the
+/// acoustic condition `fluid.cfl` · 0.25 h / c0 (WCSPH) and the viscous one, 0.125 h² / ν (§4.2; WCSPH times
+/// `fluid.cfl`). `None` where neither applies (an inviscid ISPH fluid, whose step follows its speed) or c0 has no
+/// default. A run needs at least `run.end_time` over this many fluid steps.
+pub fn longest(spec: &cosim_proto::scene::FluidSpec, gravity: [f64; 2]) -> Option<(f64, &'static str)> {
+    let h = spec.smoothing_ratio * spec.spacing;
+    let wcsph = matches!(spec.solver, cosim_proto::scene::FluidSolver::Wcsph);
+    let cfl = if wcsph { spec.cfl } else { 1.0 };
+    let mut bound: Option<(f64, &'static str)> = None;
+    let mut take = |dt: f64, key: &'static str| {
+        if bound.is_none_or(|(b, _)| dt < b) {
+            bound = Some((dt, key));
+        }
+    };
+    if wcsph {
+        let c0 = crate::setup::sound_speed(spec, gravity).ok()?;
+        take(cfl * 0.25 * h / c0, "fluid.sound_speed"); // §4.2: acoustic (CFL) condition
+    }
+    if spec.kinematic_viscosity > 0.0 {
+        take(
+            cfl * 0.125 * h * h / spec.kinematic_viscosity,
+            "fluid.kinematic_viscosity",
+        ); // §4.2: viscous condition
+    }
+    bound
+}

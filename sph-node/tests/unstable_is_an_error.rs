@@ -20,3 +20,42 @@ fn oversized_step_reports_unstable() {
     }
     assert!(matches!(solver.step(-1.0), Err(SphError::InvalidParameter { .. })));
 }
+
+/// A stable step that would need more than 2^32 sub-steps in one coupling step (here a viscosity of 1e300 m²/s,
+/// 0.125 h²/ν ≈ 1e-307 s) is a typed error at once, for both solvers, not a coupling step that never ends.
+#[test]
+fn a_collapsed_step_is_an_error_not_an_endless_subcycle() {
+    use cosim_proto::messages::StepCommand;
+    use sph_node::core::SphCore;
+    for solver in ["wcsph", "isph"] {
+        let scene = common::still_water(
+            0.2,
+            0.2,
+            0.02,
+            &format!("solver = \"{solver}\"\nkinematic_viscosity = 1e300"),
+        );
+        let mut core = SphCore::new(&scene).expect("core");
+        let command = StepCommand {
+            dt: 1e-3,
+            corrections: Vec::new(),
+            roi: None,
+            want_interface: false,
+            want_snapshot: false,
+            stop: false,
+        };
+        let started = std::time::Instant::now();
+        let err = core.handle(&command).expect_err("no usable step");
+        assert!(
+            started.elapsed().as_secs_f64() < 10.0,
+            "{solver}: the error comes at once"
+        );
+        match &err {
+            SphError::StepCollapsed { step, stable, left } => {
+                assert_eq!(*step, 1, "{solver}");
+                assert!(*stable < 1e-300 && *left == 1e-3, "{solver}: {err}");
+            }
+            other => panic!("{solver}: expected StepCollapsed, got {other}"),
+        }
+        assert!(err.is_unstable(), "{solver}");
+    }
+}

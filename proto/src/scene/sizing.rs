@@ -462,6 +462,17 @@ pub fn count(n: f64) -> String {
     }
 }
 
+/// A value as it reads best in a message: as written between 1e-4 and 1e7, in scientific notation beyond (a
+/// `coupling.max_dt` of 1e-300 is not 300 zeros).
+pub fn number(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Bytes in binary units (KiB, MiB, GiB, TiB, …).
 pub fn bytes_text(bytes: f64) -> String {
     const UNITS: [&str; 7] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
