@@ -82,8 +82,9 @@ fn main() {
     cosim_bus::log::init();
     if let Err(e) = run(Args::parse()) {
         cosim_bus::log::say(&format!("contact-broker: {}", format!("{e:#}").replace('\n', " ")));
-        // A run id that is live already is refused input (exit 2, as `cosim run` gives for bad input).
-        std::process::exit(if cosim_bus::claim::is_refusal(&e) { 2 } else { 1 });
+        // A run id that is live already and a scene refused are bad input (exit 2, as `cosim run` gives for it).
+        let bad_input = cosim_bus::claim::is_refusal(&e) || e.chain().any(|c| c.is::<cosim_proto::scene::SceneError>());
+        std::process::exit(if bad_input { 2 } else { 1 });
     }
 }
 

@@ -89,12 +89,32 @@ fn a_run_that_could_never_end_is_refused_naming_the_key() {
     both_refuse(
         "scenes/dam_break.toml",
         &["fluid.kinematic_viscosity=1e300"],
-        &["fluid.kinematic_viscosity", "1e300 m²/s", "8.450e-307 s", "fluid steps", "1e12"],
+        &[
+            "fluid.kinematic_viscosity",
+            "1e300 m²/s",
+            "8.450e-307 s",
+            "fluid steps",
+            "1e12",
+        ],
     );
     both_refuse(
         "scenes/elastic_gate.toml",
         &["fluid.sound_speed=1e300"],
         &["fluid.sound_speed", "1e300 m/s", "0.25 h/c0"],
+    );
+    // The broker started by hand (a run over several hosts) refuses it the same way, as bad input.
+    let out_dir = scratch("limits-broker");
+    let mut broker = std::process::Command::new(program("contact-broker"));
+    broker
+        .current_dir(root())
+        .args(["--run", &run_id("endless"), "--scene", "scenes/csm3.toml"])
+        .args(["--set", "coupling.max_dt=1e-300", "--out"])
+        .arg(&*out_dir);
+    let out = run_bounded(&mut broker, LIMIT);
+    let line = refused(&out, "contact-broker", &["coupling.max_dt", "1e12"]);
+    assert!(
+        line.starts_with("contact-broker: scenes/csm3.toml: coupling.max_dt: "),
+        "{line}"
     );
 }
 
