@@ -356,3 +356,32 @@ fn verlet_skin_is_for_wcsph_in_its_range_and_defaults_to_0_2() {
         "f.toml: fluid.verlet_skin: applies to solver = \"wcsph\" only (the ISPH search runs every step)"
     );
 }
+
+#[test]
+fn a_fluid_without_gravity_needs_its_sound_speed() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let refused = "f.toml: fluid.sound_speed: cannot default to 10 sqrt(2 g H) without gravity";
+    // The gate gives c0 = 20 m/s; without it, gravity sets the default.
+    let without = text.replace("sound_speed = 20.0", "");
+    assert!(parse("f.toml", &without, &[]).is_ok());
+    let e = err(&without, &["run.gravity=[0, 0]"]);
+    assert!(e.starts_with(refused), "{e}");
+    // ISPH needs c0 only for the `particle_particle` force against a solid.
+    assert!(parse(
+        "f.toml",
+        &without,
+        &["run.gravity=[0, 0]".into(), "fluid.solver=\"isph\"".into()]
+    )
+    .is_ok());
+    let pp = [
+        "run.gravity=[0, 0]",
+        "fluid.solver=\"isph\"",
+        "contact.algorithm=\"particle_particle\"",
+    ];
+    assert!(err(&without, &pp).starts_with(refused));
+    assert!(
+        parse("f.toml", &text, &["run.gravity=[0, 0]".into()]).is_ok(),
+        "a value given"
+    );
+}

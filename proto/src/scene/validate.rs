@@ -288,6 +288,16 @@ impl Scene {
         }
         if let Some(fluid) = &self.fluid {
             validate_fluid(fluid, &self.walls, &self.solids)?;
+            // c0 defaults to 10 sqrt(2 g H) (`sph_node::setup::sound_speed`): WCSPH always needs it, ISPH for the
+            // `particle_particle` force. Without gravity there is no default, and the fluid node failed at start
+            // where `cosim check` refused (found 2026-12-06).
+            let needs_c0 = fluid.solver == FluidSolver::Wcsph
+                || (self.contact.algorithm == ContactAlgorithm::ParticleParticle && !self.solids.is_empty());
+            check(
+                fluid.sound_speed.is_some() || !needs_c0 || self.run.gravity != [0.0, 0.0],
+                || "fluid.sound_speed".into(),
+                || "cannot default to 10 sqrt(2 g H) without gravity (run.gravity is [0, 0]); give a value".into(),
+            )?;
         }
         for (w, wall) in self.walls.iter().enumerate() {
             check(
