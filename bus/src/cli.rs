@@ -25,8 +25,8 @@ struct Args {
     /// Seconds to wait for the connection and the scene.
     #[arg(long, default_value_t = 5.0)]
     timeout: f64,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
+    /// Worker threads (default: all cores; 1 to 1024).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
     threads: Option<usize>,
     /// `--connect` is a zenoh router (`zenohd`): join through it as a client, as every process of the run must.
     #[arg(long, conflicts_with = "listen")]

@@ -105,8 +105,8 @@ pub struct RunArgs {
     /// Connect every node to this zenoh router (e.g. `zenohd`) as a zenoh client instead of peer-to-peer on loopback.
     #[arg(long)]
     pub connect: Option<String>,
-    /// Worker threads per node (default: all cores).
-    #[arg(long)]
+    /// Worker threads per node (default: all cores; 1 to 1024).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
     pub threads: Option<usize>,
     /// A zenoh JSON5 config file (user and password, TLS certificates, …) given to every process started, as
     /// their `--zenoh-config`; their own settings (mode, endpoints, multicast scouting off) go on top of it.

@@ -33,9 +33,6 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         Some(id) => anyhow::bail!("--run-id `{id}`: use 1–64 letters, digits, - and _"),
         None => fresh_run_id(),
     };
-    if let Some(n) = args.threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
-    }
     // A zenoh config file that cannot be read or parsed is bad input, said once here rather than by each process.
     let args = &match &args.zenoh_config {
         Some(file) => {

@@ -119,6 +119,12 @@ fn a_run_that_could_never_end_is_refused_naming_the_key() {
 }
 
 #[test]
+fn a_scene_path_to_something_endless_is_refused() {
+    // `/dev/zero` was read until memory ran out.
+    both_refuse("/dev/zero", &[], &["/dev/zero", "(file)", "more than 16 MiB"]);
+}
+
+#[test]
 fn spacing_too_fine_for_this_machine_is_refused_with_what_it_needs_and_has() {
     // 2e9 fluid particles and 9e8 wall particles: under the id limit, but terabytes.
     let spacing = 3.2e-6;

@@ -52,13 +52,31 @@ impl LoadedScene {
 /// Read, override and validate a scene file. `overrides` are `key.path=value` strings (`--set`).
 pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError> {
     let file = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", format!("cannot read: {e}")))?;
+    let text = read_bounded(path).map_err(|message| SceneError::new(&file, "(file)", message))?;
     let scene = parse(&file, &text, overrides)?;
     Ok(LoadedScene {
         scene,
         path: path.to_path_buf(),
     })
+}
+
+/// The most bytes a scene file may have: the shipped scenes are a few KiB, and a path to something endless
+/// (`/dev/zero`, a pipe) would otherwise be read until memory runs out (found 2026-12-06: `cosim check /dev/zero`
+/// never returned).
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// The file's text, at most [`MAX_SCENE_BYTES`] of it; `Err` says why not.
+fn read_bounded(path: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot read: {e}"))?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(format!("more than {} MiB: not a scene file", MAX_SCENE_BYTES >> 20));
+    }
+    String::from_utf8(bytes).map_err(|e| format!("cannot read: not UTF-8 text ({e})"))
 }
 
 /// Parse, override and validate scene text; `file` names it in errors.
