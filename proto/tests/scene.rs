@@ -385,3 +385,33 @@ fn a_fluid_without_gravity_needs_its_sound_speed() {
         "a value given"
     );
 }
+
+#[test]
+fn a_node_probe_must_look_at_its_solid() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/csm3.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    // The bar is [0.25, 0.6] x [0.19, 0.21] in 70 x 4 cells: a cell's diagonal is 7.07e-3 m.
+    for ok in ["[0.6, 0.2]", "[0.25, 0.19]", "[0.605, 0.2]", "[0.4, 0.215]"] {
+        assert!(
+            parse("f.toml", &text, &[format!("probe[0].point={ok}")]).is_ok(),
+            "{ok}"
+        );
+    }
+    for (bad, off) in [
+        ("[0.7, 0.2]", "1.000e-1"),
+        ("[0.608, 0.2]", "8.000e-3"),
+        ("[1e308, 1e308]", "1.414e308"),
+    ] {
+        let e = err(&text, &[&format!("probe[0].point={bad}")]);
+        assert!(
+            e.starts_with(
+                &format!(
+                    "f.toml: probe[0].point: {} lies {off} m outside solid `bar`",
+                    bad.replace(' ', "")
+                )
+                .replace(",", ", ")
+            ),
+            "{e}"
+        );
+    }
+}

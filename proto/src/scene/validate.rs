@@ -10,6 +10,7 @@ use super::schema::{
 use super::sizing::Sizing;
 use crate::overlap;
 
+mod probe_point;
 mod solid;
 
 type Invalid = (String, String);
@@ -375,6 +376,10 @@ impl Scene {
                         || key("point"),
                         || "missing key (node_displacement)".into(),
                     )?;
+                    let on = self.solids.iter().find(|s| Some(&s.name) == probe.solid.as_ref());
+                    if let (Some(point), Some(solid)) = (probe.point, on) {
+                        probe_point::on_solid(p, point, solid)?;
+                    }
                     check(
                         probe.component.is_some(),
                         || key("component"),
