@@ -20,7 +20,17 @@ pub const RETRY: Duration = Duration::from_millis(200);
 /// empty list means nobody answered within `timeout`. Every answer is kept (consolidation off: zenoh would
 /// otherwise keep one answer per key, and a caller may need to know that two processes answered).
 pub fn ask(session: &Session, key: &str, timeout: Duration) -> zenoh::Result<Vec<Reply>> {
-    let deadline = Instant::now() + timeout;
+    ask_within(session, key, timeout, timeout)
+}
+
+/// As [`ask`], but asked again only within `retry_for` of the first try: after that a query that finds nobody
+/// ends the wait. For a partner that may be gone: the broker's checkpoint query to a node that died would
+/// otherwise wait out the whole `timeout` (a step's), where a link lost and restored is back within
+/// [`crate::link_loss::GRACE`].
+pub fn ask_within(session: &Session, key: &str, timeout: Duration, retry_for: Duration) -> zenoh::Result<Vec<Reply>> {
+    let start = Instant::now();
+    let deadline = start + timeout;
+    let retry_until = start + retry_for.min(timeout);
     loop {
         let asked = Instant::now();
         let left = deadline.saturating_duration_since(asked);
@@ -31,7 +41,8 @@ pub fn ask(session: &Session, key: &str, timeout: Duration) -> zenoh::Result<Vec
             .wait()?;
         // The channel closes once every queryable answered (or at the timeout).
         let answers: Vec<Reply> = std::iter::from_fn(|| replies.recv().ok()).collect();
-        if !answers.is_empty() || Instant::now() + RETRY >= deadline {
+        let now = Instant::now();
+        if !answers.is_empty() || now + RETRY >= deadline || now + RETRY >= retry_until {
             return Ok(answers);
         }
         // A query that found nobody returns at once: do not spin.

@@ -320,9 +320,15 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
         let what = self.topics.checkpoint;
-        // Asked again while nobody answers: a link lost and restored takes the node's queryable away for a moment.
-        let answers = cosim_bus::ask::ask(&self.session, &key(&self.run, what), self.step_timeout)
-            .map_err(|e| self.failed(format!("cannot ask for a checkpoint: {e}")))?;
+        // Asked again while nobody answers, for as long as a link lost and restored takes to come back (it takes the
+        // node's queryable away for a moment); a node that died is not waited for longer.
+        let answers = cosim_bus::ask::ask_within(
+            &self.session,
+            &key(&self.run, what),
+            self.step_timeout,
+            link_loss::GRACE,
+        )
+        .map_err(|e| self.failed(format!("cannot ask for a checkpoint: {e}")))?;
         let reply = answers.into_iter().next().ok_or_else(|| {
             self.failed(format!(
                 "did not answer {what} within {:.0} s (an outside program in a node's place may not save checkpoints)",
