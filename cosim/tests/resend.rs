@@ -15,6 +15,8 @@ mod common;
 
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use common::*;
@@ -32,6 +34,45 @@ fn scene_path() -> String {
 
 fn session(listen: &[String], connect: &[String]) -> zenoh::Session {
     cosim_bus::session::open_session(listen, connect, 5000).expect("zenoh session")
+}
+
+/// The broker's liveliness token, held by a broker written in a test.
+fn broker_token(s: &zenoh::Session, id: &str) -> zenoh::liveliness::LivelinessToken {
+    s.liveliness()
+        .declare_token(key(id, topic::BROKER_ALIVE))
+        .wait()
+        .unwrap()
+}
+
+/// Answer the structure node's `restore` query with "start from the scene", counting the queries in `asked`.
+fn no_restart_state(s: &zenoh::Session, id: &str, asked: Arc<AtomicUsize>) -> zenoh::query::Queryable<()> {
+    let run = id.to_string();
+    s.declare_queryable(key(id, topic::FEM_RESTORE))
+        .callback(move |q| {
+            let none = NodeCheckpoint {
+                node: "fem-node".into(),
+                data: Vec::new(),
+            };
+            q.reply(q.key_expr().clone(), Envelope::new(&run, 0, 0.0, none).encode())
+                .wait()
+                .unwrap();
+            asked.fetch_add(1, Ordering::SeqCst);
+        })
+        .wait()
+        .unwrap()
+}
+
+/// `fem-node` joining run `id` at `endpoint`, its stderr to `stderr`.
+fn fem_node(id: &str, endpoint: &str, stderr: Stdio) -> Kill {
+    Kill(
+        Command::new(program("fem-node"))
+            .args(["--run", id, "--connect", endpoint])
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(stderr)
+            .spawn()
+            .unwrap(),
+    )
 }
 
 #[test]
@@ -139,36 +180,11 @@ fn a_node_answers_a_repeated_command_again() {
         })
         .wait()
         .unwrap();
-    let run = id.clone();
-    let _restore = s
-        .declare_queryable(key(&id, topic::FEM_RESTORE))
-        .callback(move |q| {
-            let none = NodeCheckpoint {
-                node: "fem-node".into(),
-                data: Vec::new(),
-            };
-            q.reply(q.key_expr().clone(), Envelope::new(&run, 0, 0.0, none).encode())
-                .wait()
-                .unwrap();
-        })
-        .wait()
-        .unwrap();
-    let _alive = s
-        .liveliness()
-        .declare_token(key(&id, topic::BROKER_ALIVE))
-        .wait()
-        .unwrap();
+    let _restore = no_restart_state(&s, &id, Arc::default());
+    let _alive = broker_token(&s, &id);
     let mesh = s.declare_subscriber(key(&id, topic::FEM_MESH)).wait().unwrap();
     let states = s.declare_subscriber(key(&id, topic::FEM_STATE)).wait().unwrap();
-    let mut node = Kill(
-        Command::new(program("fem-node"))
-            .args(["--run", &id, "--connect", &endpoint])
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
-    );
+    let mut node = fem_node(&id, &endpoint, Stdio::null());
     mesh.recv_timeout(LIMIT).unwrap().expect("the node registers");
     let command = |step: u64, t: f64, dt: f64, stop: bool| {
         let body = StepCommand {
@@ -215,8 +231,6 @@ fn a_node_answers_a_repeated_command_again() {
 
 #[test]
 fn a_node_asks_again_while_nobody_answers_its_query() {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::Arc;
     let id = run_id("ask-again");
     let endpoint = format!("tcp/127.0.0.1:{}", free_port());
     let s = session(std::slice::from_ref(&endpoint), &[]);
@@ -234,21 +248,9 @@ fn a_node_asks_again_while_nobody_answers_its_query() {
         })
         .wait()
         .unwrap();
-    let _alive = s
-        .liveliness()
-        .declare_token(key(&id, topic::BROKER_ALIVE))
-        .wait()
-        .unwrap();
+    let _alive = broker_token(&s, &id);
     let mesh = s.declare_subscriber(key(&id, topic::FEM_MESH)).wait().unwrap();
-    let mut node = Kill(
-        Command::new(program("fem-node"))
-            .args(["--run", &id, "--connect", &endpoint])
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    );
+    let mut node = fem_node(&id, &endpoint, Stdio::piped());
     let started = Instant::now();
     while scenes_served.load(Ordering::SeqCst) == 0 {
         assert!(started.elapsed() < LIMIT, "the node never asked for the scene");
@@ -261,22 +263,7 @@ fn a_node_asks_again_while_nobody_answers_its_query() {
         "the node gave up on a query nobody could answer yet"
     );
     let asked = Arc::new(AtomicUsize::new(0));
-    let counted = asked.clone();
-    let run = id.clone();
-    let _restore = s
-        .declare_queryable(key(&id, topic::FEM_RESTORE))
-        .callback(move |q| {
-            let none = NodeCheckpoint {
-                node: "fem-node".into(),
-                data: Vec::new(),
-            };
-            q.reply(q.key_expr().clone(), Envelope::new(&run, 0, 0.0, none).encode())
-                .wait()
-                .unwrap();
-            counted.fetch_add(1, Ordering::SeqCst);
-        })
-        .wait()
-        .unwrap();
+    let _restore = no_restart_state(&s, &id, asked.clone());
     let registered = mesh.recv_timeout(LIMIT).unwrap();
     if registered.is_none() {
         node.0.kill().unwrap();

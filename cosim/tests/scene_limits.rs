@@ -121,7 +121,7 @@ fn a_run_that_could_never_end_is_refused_naming_the_key() {
 #[test]
 fn a_scene_path_to_something_endless_is_refused() {
     // `/dev/zero` was read until memory ran out.
-    both_refuse("/dev/zero", &[], &["/dev/zero", "(file)", "more than 16 MiB"]);
+    both_refuse("/dev/zero", &[], &["/dev/zero", "(file)", "more than 256 MiB"]);
 }
 
 #[test]

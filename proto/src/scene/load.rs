@@ -60,10 +60,11 @@ pub fn load(path: &Path, overrides: &[String]) -> Result<LoadedScene, SceneError
     })
 }
 
-/// The most bytes a scene file may have: the shipped scenes are a few KiB, and a path to something endless
+/// The most bytes a scene file may have: the shipped scenes are a few KiB (a million probes, which `cosim check`
+/// takes, about 60 MiB), and a path to something endless
 /// (`/dev/zero`, a pipe) would otherwise be read until memory runs out (found 2026-12-06: `cosim check /dev/zero`
 /// never returned).
-pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 
 /// The file's text, at most [`MAX_SCENE_BYTES`] of it; `Err` says why not.
 fn read_bounded(path: &Path) -> Result<String, String> {
