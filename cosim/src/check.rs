@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use cosim_bus::memory;
 use cosim_proto::scene::{self, DensityFilter};
-use cosim_proto::sizing::{bytes_text, Part, Sizing};
+use cosim_proto::sizing::{bytes_text, count, Part, Sizing};
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -59,6 +59,11 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     }
     let samples = s.run.sample_count();
     let frames = s.run.frame_count();
+    // The run's work from the same estimates: what its time grows with (a mesh of 1e5 thin cells was "valid" at
+    // 3e14 element-steps, a year on one core, and nothing said so).
+    let fluid_steps = fluid.as_ref().map_or(0.0, |_| (s.run.end_time / dt_fluid).ceil());
+    let element_steps = elements as f64 * steps as f64 * substeps.unwrap_or(0) as f64;
+    let particle_steps = particles as f64 * fluid_steps;
     if args.json {
         let doc = serde_json::json!({
             "scene": args.scene.display().to_string(),
@@ -76,6 +81,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "coupling_fluid_steps_per_pass": coupled.then_some(fluid_span),
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
+            "work": { "element_steps": element_steps, "particle_steps": particle_steps },
             // A fluid particle's mass over one mesh cell's, per solid (proto::scene::mass_ratio).
             "particle_to_cell_mass": ratios
                 .iter()
@@ -204,6 +210,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         );
     }
     println!("  totals: {nodes} FE nodes, {elements} elements, {particles} particles (coupling steps are estimated from the initial stable step)");
+    println!(
+        "  work: about {} element-steps and {} fluid particle-steps (what the run time grows with; docs/PERFORMANCE.md \
+         has each solver's rate)",
+        count(element_steps),
+        count(particle_steps)
+    );
     // A node the scene does not start has no share.
     let part = |p: Part, name: &str| (sizing.bytes(p) > 0.0).then(|| format!("{name} {}", bytes_text(sizing.bytes(p))));
     let parts: Vec<String> = [
