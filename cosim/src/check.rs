@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use cosim_bus::memory;
-use cosim_proto::scene::{self, DensityFilter};
+use cosim_proto::scene::DensityFilter;
 use cosim_proto::sizing::{bytes_text, count, Part, Sizing};
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
@@ -13,17 +13,12 @@ use crate::cli::CheckArgs;
 
 /// Validate and describe; `Err` (exit 2) names the file, the key and the problem.
 pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
-    let loaded = scene::load(&args.scene, &args.set)?;
-    let s = &loaded.scene;
+    // Loaded and refused as `cosim run` and `contact-broker` do (memory, ids, a run that could never end).
+    let setup = contact_broker::setup::RunSetup::load(&args.scene, &args.set, Part::Run)?;
+    let s = &setup.scene.scene;
     // Sized from the scene alone, before the structure and the fluid are built below.
     let sizing = Sizing::of(s);
     let available = memory::available();
-    memory::refuse_above(s, Part::Run, &args.scene.display().to_string(), available)?;
-    contact_broker::step_budget::refuse_endless(s).map_err(|(key, message)| scene::SceneError {
-        file: args.scene.display().to_string(),
-        key,
-        message,
-    })?;
     let (dt_fem, nodes, elements) = if s.solids.is_empty() {
         (None, 0, 0)
     } else {
@@ -61,9 +56,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let frames = s.run.frame_count();
     // The run's work from the same estimates: what its time grows with (a mesh of 1e5 thin cells was "valid" at
     // 3e14 element-steps, a year on one core, and nothing said so).
-    let fluid_steps = fluid.as_ref().map_or(0.0, |_| (s.run.end_time / dt_fluid).ceil());
+    let fluid_steps = fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil());
     let element_steps = elements as f64 * steps as f64 * substeps.unwrap_or(0) as f64;
-    let particle_steps = particles as f64 * fluid_steps;
+    let particle_steps = particles as f64 * fluid_steps.unwrap_or(0.0);
     if args.json {
         let doc = serde_json::json!({
             "scene": args.scene.display().to_string(),
@@ -74,7 +69,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "particles": particles,
             "wall_particles": walls,
             "sph_dt_stable": fluid.as_ref().map(|_| dt_fluid),
-            "sph_steps_estimate": fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil() as u64),
+            "sph_steps_estimate": fluid_steps.map(|n| n as u64),
             "coupling_dt": dt,
             "coupling_steps": steps,
             "coupling_dt_bounded_by_contact": contact_bound,
@@ -157,7 +152,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             f.spacing,
             core.setup().h,
             dt_fluid,
-            (s.run.end_time / dt_fluid).ceil()
+            fluid_steps.unwrap_or(0.0)
         ),
         _ => println!("  fluid: none"),
     }

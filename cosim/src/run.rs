@@ -12,7 +12,7 @@ use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
-use cosim_proto::scene::{LoadedScene, STRUCTURE_COURANT_DEFAULT};
+use cosim_proto::scene::{LoadedScene, STRUCTURE_COURANT_DEFAULT, STRUCTURE_COURANT_MIN};
 use cosim_proto::sizing::Part;
 use cosim_proto::trace::Node;
 use fem_node::core::FemCore;
@@ -179,10 +179,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             // A structure whose surface moves a large part of h between two contact passes (docs/CORRECTIONS.md
             // "The coupling step bounded by the structure's speed").
             let c = scene.scene.coupling.structure_courant;
-            // (Halved down to the key's least value, 1e-3; at that value there is nothing shorter to suggest.)
-            if !scene.scene.solids.is_empty() && scene.scene.fluid.is_some() && (c == 0.0 || c > 1e-3) {
+            // (Halved down to the key's least value; at that value there is nothing shorter to suggest.)
+            if !scene.scene.solids.is_empty() && scene.scene.fluid.is_some() && (c == 0.0 || c > STRUCTURE_COURANT_MIN)
+            {
                 let try_c = if c > 0.0 {
-                    (0.5 * c).max(1e-3)
+                    (0.5 * c).max(STRUCTURE_COURANT_MIN)
                 } else {
                     STRUCTURE_COURANT_DEFAULT
                 };

@@ -38,8 +38,7 @@ pub fn longest(spec: &cosim_proto::scene::FluidSpec, gravity: [f64; 2]) -> Optio
         }
     };
     if wcsph {
-        let c0 = crate::setup::sound_speed(spec, gravity).ok()?;
-        take(cfl * 0.25 * h / c0, "fluid.sound_speed"); // §4.2: acoustic (CFL) condition
+        take(at_rest(spec, gravity)?, "fluid.sound_speed"); // §4.2: acoustic (CFL) condition
     }
     if spec.kinematic_viscosity > 0.0 {
         take(

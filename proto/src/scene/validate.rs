@@ -5,7 +5,7 @@ use std::collections::HashSet;
 
 use super::schema::{
     BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, FLUID_SUBSTEPS_MAX,
-    ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION,
+    ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION, STRUCTURE_COURANT_MIN,
 };
 use super::sizing::Sizing;
 use crate::overlap;
@@ -236,9 +236,8 @@ impl Scene {
             || format!("must be in (0, 0.9], got {}", self.coupling.fem_cfl),
         )?;
         check(
-            // Below 1e-3 (50 times the default's steps) the bound makes a run crawl, 1e-300 by ~1e9 coupling
-            // steps a simulated millisecond: not a setting anyone means.
-            self.coupling.structure_courant == 0.0 || (1e-3..=1.0).contains(&self.coupling.structure_courant),
+            self.coupling.structure_courant == 0.0
+                || (STRUCTURE_COURANT_MIN..=1.0).contains(&self.coupling.structure_courant),
             || "coupling.structure_courant".into(),
             || {
                 format!(

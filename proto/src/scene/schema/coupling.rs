@@ -60,6 +60,10 @@ fn is_default_fluid_substeps(k: &u32) -> bool {
 /// gate at its own step keeps its energy (docs/CORRECTIONS.md).
 pub const STRUCTURE_COURANT_DEFAULT: f64 = 0.05;
 
+/// The least `coupling.structure_courant` other than 0 (off): below it the bound makes a run crawl (50 times the
+/// default's steps at 1e-3; 1e-300 took ~1e9 coupling steps a simulated millisecond), not a setting anyone means.
+pub const STRUCTURE_COURANT_MIN: f64 = 1e-3;
+
 fn default_structure_courant() -> f64 {
     STRUCTURE_COURANT_DEFAULT
 }

@@ -10,7 +10,10 @@ mod solid;
 use serde::{Deserialize, Serialize};
 
 pub use contact::{ContactAlgorithm, ContactSpec};
-pub use coupling::{whole_fluid_steps, CouplingSpec, FLUID_SUBSTEPS_MAX, STRUCTURE_COURANT_DEFAULT, SUBSTEP_SLACK};
+pub use coupling::{
+    whole_fluid_steps, CouplingSpec, FLUID_SUBSTEPS_MAX, STRUCTURE_COURANT_DEFAULT, STRUCTURE_COURANT_MIN,
+    SUBSTEP_SLACK,
+};
 pub use fluid::{
     DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT,
     ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
