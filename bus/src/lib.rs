@@ -8,6 +8,7 @@
 pub mod ask;
 pub mod claim;
 pub mod cli;
+pub mod disk;
 pub mod interrupt;
 pub mod link_loss;
 pub mod log;

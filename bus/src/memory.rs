@@ -99,7 +99,7 @@ max = [0.4, 0.5]
         let err = refuse_above(&scene, Part::Fluid, "(scene from the broker)", Some(16 * gib)).unwrap_err();
         let line = err.to_string();
         assert!(
-            line.starts_with("(scene from the broker): fluid.spacing: 0.00001 m fills"),
+            line.starts_with("(scene from the broker): fluid.spacing: 1e-5 m fills"),
             "{line}"
         );
         assert!(line.contains("2.00e9 particles"), "{line}");

@@ -122,7 +122,8 @@ pub fn check_interval(interval: Option<f64>) -> anyhow::Result<()> {
     if let Some(i) = interval {
         anyhow::ensure!(
             i.is_finite() && i > 0.0,
-            "--checkpoint-interval must be a positive number of seconds, got {i}"
+            "--checkpoint-interval must be a positive number of seconds, got {}",
+            cosim_proto::Num(i)
         );
     }
     Ok(())

@@ -61,6 +61,9 @@ struct Args {
     /// Continue from this checkpoint folder (`DIR/checkpoints/<step>`) instead of from the scene.
     #[arg(long, value_name = "DIR")]
     restart: Option<PathBuf>,
+    /// Start even where the outputs are estimated larger than the free space of `--out`'s disk (refused without it).
+    #[arg(long)]
+    ignore_disk_space: bool,
     /// A zenoh JSON5 config file the session starts from (user and password, TLS certificates, …); the broker's
     /// own settings (mode, endpoints, multicast scouting off, timeouts) are put on top of it.
     #[arg(long, value_name = "FILE")]
@@ -105,6 +108,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     );
     let setup = RunSetup::load(&args.scene, &args.set, Part::Broker)?
         .with_checkpoints(args.checkpoint_interval, args.restart.as_deref())?;
+    if !args.ignore_disk_space {
+        setup.refuse_full_disk(&args.out)?;
+    }
     // From here on a signal stops the run between two steps instead of killing the broker mid-step.
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let base = args.zenoh_config.as_deref();

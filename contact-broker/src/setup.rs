@@ -54,6 +54,21 @@ impl RunSetup {
         Ok(self)
     }
 
+    /// Refuse a run whose outputs (frames, probe table, checkpoints; from the restart's time when it continues one)
+    /// cannot fit the free space of `out`'s disk, naming the key that makes them large (`cosim_bus::disk`).
+    pub fn refuse_full_disk(&self, out: &Path) -> anyhow::Result<()> {
+        let from = self.restart.as_ref().map_or(0.0, |r| r.broker.t);
+        cosim_bus::disk::refuse_above(
+            &self.scene.scene,
+            &self.scene.path.display().to_string(),
+            out,
+            self.checkpoint_interval,
+            from,
+            cosim_bus::disk::free(out),
+        )?;
+        Ok(())
+    }
+
     /// The structure node's saved state to restore, when the run continues from a checkpoint.
     pub fn saved_fem(&self) -> Option<&Vec<u8>> {
         self.restart.as_ref().and_then(|r| r.fem.as_ref())

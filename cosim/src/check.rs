@@ -4,8 +4,10 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use cosim_bus::memory;
+use cosim_proto::scene::disk::DiskEstimate;
 use cosim_proto::scene::DensityFilter;
 use cosim_proto::sizing::{bytes_text, count, Part, Sizing};
+use cosim_proto::Num;
 use fem_node::core::FemCore;
 use sph_node::core::SphCore;
 
@@ -54,6 +56,8 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     }
     let samples = s.run.sample_count();
     let frames = s.run.frame_count();
+    // What the run writes into its output folder (no checkpoints: `run --checkpoint-interval` adds them).
+    let disk = DiskEstimate::of(s, &sizing, None, 0.0);
     // The run's work from the same estimates: what its time grows with (a mesh of 1e5 thin cells was "valid" at
     // 3e14 element-steps, a year on one core, and nothing said so).
     let fluid_steps = fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil());
@@ -99,6 +103,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
                 "fem_node_bytes": sizing.bytes(Part::Structure) as u64,
                 "broker_bytes": sizing.bytes(Part::Broker) as u64,
                 "available_bytes": available,
+                "output_bytes": disk.total() as u64,
+                "frame_bytes": disk.frame_bytes as u64,
+                "checkpoint_bytes": disk.checkpoint_bytes as u64,
             },
             // The corrections in force (§4.4), the per-solver defaults filled in.
             "corrections": s.fluid.as_ref().map(|f| serde_json::json!({
@@ -116,9 +123,11 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     println!("scene {} ({}): valid", args.scene.display(), s.run.name);
     println!(
         "  run: end_time {} s, output every {} s ({samples} probe samples, {frames} frames{}), gravity {:?}",
-        s.run.end_time,
-        s.run.output_interval,
-        s.run.frame_interval.map_or(String::new(), |f| format!(" every {f} s")),
+        Num(s.run.end_time),
+        Num(s.run.output_interval),
+        s.run
+            .frame_interval
+            .map_or(String::new(), |f| format!(" every {} s", Num(f))),
         s.run.gravity
     );
     for solid in &s.solids {
@@ -132,16 +141,16 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             nx * ny,
             solid.element_count(),
             solid.material.model,
-            solid.material.youngs_modulus,
-            solid.material.poisson_ratio,
-            solid.material.density,
+            Num(solid.material.youngs_modulus),
+            Num(solid.material.poisson_ratio),
+            Num(solid.material.density),
             solid.fixed.len(),
-            solid.damping
+            Num(solid.damping)
         );
         if solid.mesh_damping > 0.0 {
             println!(
                 "    mesh damping: stiffness-proportional, a ratio of {} at the mesh's highest mode",
-                solid.mesh_damping
+                Num(solid.mesh_damping)
             );
         }
     }
@@ -149,7 +158,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         (Some(f), Some(core)) => println!(
             "  fluid: {:?}, {particles} particles + {walls} wall particles, spacing {} m, h = {:.4} m, stable dt {:.3e} s (about {} steps)",
             f.solver,
-            f.spacing,
+            Num(f.spacing),
             core.setup().h,
             dt_fluid,
             fluid_steps.unwrap_or(0.0)
@@ -163,27 +172,27 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             other => format!("{other:?} density filter every {} steps", f.density_filter_interval),
         };
         let diffusion = match f.density_diffusion {
-            d if d > 0.0 => format!(", density diffusion delta = {d} (Fourtakas et al. 2019)"),
+            d if d > 0.0 => format!(", density diffusion delta = {} (Fourtakas et al. 2019)", Num(d)),
             _ => String::new(),
         };
         println!(
             "  corrections: {filter}, XSPH eps = {}, APD beta = {}{diffusion}",
-            f.xsph,
-            f.apd()
+            Num(f.xsph),
+            Num(f.apd())
         );
         if f.verlet_skin() > 0.0 {
             println!(
                 "  search: Verlet candidates within 2h + {} h, gathered again when a particle has moved {} h",
-                f.verlet_skin(),
-                0.5 * f.verlet_skin()
+                Num(f.verlet_skin()),
+                Num(0.5 * f.verlet_skin())
             );
         }
     }
     match (dt_fem, substeps) {
         (Some(d), Some(k)) => println!(
-            "  steps: coupling dt {dt} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
+            "  steps: coupling dt {dt:.4e} s x {steps} steps; FEM stable dt {d:.3e} s -> {k} sub-step(s) per coupling step"
         ),
-        _ => println!("  steps: coupling dt {dt} s x {steps} steps"),
+        _ => println!("  steps: coupling dt {dt:.4e} s x {steps} steps"),
     }
     if coupled && fluid_span > 1 {
         println!(
@@ -193,7 +202,10 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         );
     }
     for (name, ratio) in &ratios {
-        println!("  contact: a fluid particle weighs {ratio:.1} cells of solid {name}");
+        println!(
+            "  contact: a fluid particle weighs {:.1} cells of solid {name}",
+            Num(*ratio)
+        );
     }
     for w in &warnings {
         println!("  warning: {w}");
@@ -227,6 +239,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
         parts.join(", "),
         available.map_or("unknown".to_string(), |a| bytes_text(a as f64))
     );
+    println!("  disk: {}", disk.text());
     for p in &s.probes {
         println!("  probe {}: {:?}", p.name, p.kind);
     }

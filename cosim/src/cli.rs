@@ -131,6 +131,11 @@ pub struct RunArgs {
     /// the one it was written with (only `run.end_time` may differ).
     #[arg(long, value_name = "CHECKPOINT")]
     pub restart: Option<PathBuf>,
+    /// Start even where the outputs (frames, probes, checkpoints; `cosim check` prints their size) are estimated
+    /// larger than the free space of the output folder's disk: a file system that compresses them, or frames moved
+    /// away as they come. Without it such a run is refused (exit 2) rather than failed when the disk is full.
+    #[arg(long)]
+    pub ignore_disk_space: bool,
     /// Keep every message of the run (setup, commands, states, with their envelopes) in `DIR/trace/`, for
     /// `cosim replay` (format: `docs/PROTOCOL.md` §10).
     #[arg(long)]

@@ -50,7 +50,7 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
     anyhow::ensure!(
         how.timeout.is_finite() && how.timeout > 0.0,
         "--timeout must be a positive number of seconds, got {}",
-        how.timeout
+        cosim_proto::Num(how.timeout)
     );
     let timeout_ms = (how.timeout * 1000.0) as u64;
     let base = zenoh_config.as_deref();

@@ -213,6 +213,9 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
     if args.record {
         broker_args.push("--record".into());
     }
+    if args.ignore_disk_space {
+        broker_args.push("--ignore-disk-space".into());
+    }
     if let Some(condition) = &args.break_on {
         broker_args.extend(["--break".into(), condition.to_string()]);
     }

@@ -68,7 +68,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         anyhow::ensure!(
             args.wait_external.is_finite() && args.wait_external > 0.0,
             "--wait-external must be a positive number of seconds, got {}",
-            args.wait_external
+            cosim_proto::Num(args.wait_external)
         );
     }
     if let (Some(condition), true) = (&args.break_on, args.in_process) {
@@ -94,6 +94,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.scene.run.name));
+    // Outputs that cannot fit the folder's disk are bad input too, said before the folder is touched.
+    if !args.ignore_disk_space {
+        setup.refuse_full_disk(&out)?;
+    }
     // A restart into the folder of the run it continues keeps that run's frames; anywhere else they are cleared.
     let own_folder = setup.restart.as_ref().is_some_and(|r| {
         let parent = r

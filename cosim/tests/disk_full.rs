@@ -94,9 +94,34 @@ fn a_full_disk_ends_the_run_with_a_summary_naming_the_file() {
     let dir = scratch("disk-full");
     let scene = "scenes/csm3.toml";
     let (processes, in_process) = (dir.join("processes"), dir.join("in-process"));
-    run_on_a_small_disk(&processes, &[scene, "--run-id", &run_id("disk-full")]);
+    // Started anyway: the 68 kB frames fill the disk within the first few.
+    let anyway = "--ignore-disk-space";
+    run_on_a_small_disk(&processes, &[scene, anyway, "--run-id", &run_id("disk-full")]);
     check(&processes);
-    run_on_a_small_disk(&in_process, &[scene, "--in-process"]);
+    run_on_a_small_disk(&in_process, &[scene, anyway, "--in-process"]);
     check(&in_process);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The same run without `--ignore-disk-space` is refused before it starts (exit 2, one line): its 1001 frames of
+/// 66.6 KiB (`proto::scene::disk`: 65 MiB with the probe table) against the 256 KiB the disk has, naming
+/// `run.output_interval`; nothing is written there.
+#[test]
+fn outputs_larger_than_the_disk_are_refused_before_the_run_starts() {
+    let dir = scratch("disk-refused");
+    let keep = dir.join("every-output");
+    run_on_a_small_disk(&keep, &["scenes/csm3.toml", "--in-process"]);
+    let read = |name: &str| std::fs::read_to_string(keep.join(name)).unwrap_or_default();
+    let stderr = read("stderr");
+    assert_eq!(read("rc").trim(), "2", "exit code; stderr: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line expected: {stderr}");
+    assert!(
+        lines[0].contains("scenes/csm3.toml: run.output_interval: 0.01 s writes 1001 frames of 66.6 KiB")
+            && lines[0].contains("has 256.0 KiB free"),
+        "{stderr}"
+    );
+    let files = read("files");
+    assert!(!files.contains("/out"), "the refused run wrote: {files}");
     let _ = std::fs::remove_dir_all(&dir);
 }

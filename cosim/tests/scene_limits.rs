@@ -75,7 +75,7 @@ fn spacing_too_fine_for_u32_ids_is_refused_naming_the_spacing() {
     both_refuse(
         "scenes/dam_break.toml",
         &["fluid.spacing=1e-6"],
-        &["dam_break.toml", "fluid.spacing", &format!("{}", 1e-6), "u32"],
+        &["dam_break.toml", "fluid.spacing: 1e-6 m", "u32"],
     );
 }
 
@@ -118,6 +118,38 @@ fn a_run_that_could_never_end_is_refused_naming_the_key() {
     );
 }
 
+/// Outputs no disk holds (the gate's 1 MiB frames every 1e-7 s: 4e6 of them, 4 TiB) are refused by `cosim run`,
+/// processes and in-process, and by the broker started by hand, naming the key, before anything is written;
+/// `cosim check` says what they need instead (the output folder is `run`'s to choose).
+#[test]
+fn outputs_no_disk_holds_are_refused_naming_the_key() {
+    let sets = ["run.output_interval=1e-7"];
+    let said = ["run.output_interval: 1e-7 s writes 4000002 frames of 1.0 MiB", "free"];
+    for mode in [None, Some("--in-process")] {
+        let mut args = sets.to_vec();
+        args.extend(mode);
+        let out = cosim("run", "scenes/elastic_gate.toml", &args, LIMIT);
+        refused(&out, &format!("run {mode:?}"), &said);
+    }
+    let out = cosim("check", "scenes/elastic_gate.toml", &sets, LIMIT);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "check: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        text.contains("  disk: about 3.9 TiB written to the output folder (4000002 frames of 1.0 MiB"),
+        "{text}"
+    );
+    let out_dir = scratch("limits-disk-broker").child("out");
+    let mut broker = std::process::Command::new(program("contact-broker"));
+    broker
+        .current_dir(root())
+        .args(["--run", &run_id("disk"), "--scene", "scenes/elastic_gate.toml"])
+        .args(["--set", sets[0], "--out"])
+        .arg(&*out_dir);
+    let out = run_bounded(&mut broker, LIMIT);
+    refused(&out, "contact-broker", &said);
+    assert!(!out_dir.exists(), "the refused broker made its output folder");
+}
+
 #[test]
 fn a_scene_path_to_something_endless_is_refused() {
     // `/dev/zero` was read until memory ran out.
@@ -134,11 +166,7 @@ fn spacing_too_fine_for_this_machine_is_refused_with_what_it_needs_and_has() {
         &[&format!("fluid.spacing={spacing}")],
         LIMIT,
     );
-    let line = refused(
-        &line,
-        "check",
-        &["fluid.spacing", &format!("{spacing}"), "TiB", "available"],
-    );
+    let line = refused(&line, "check", &["fluid.spacing: 3.2e-6 m", "TiB", "available"]);
     assert!(!line.contains("u32"), "the id limit is not what stops it: {line}");
     both_refuse(
         "scenes/dam_break.toml",
@@ -242,6 +270,22 @@ fn non_finite_scene_numbers_are_refused_naming_the_key() {
     ] {
         let out = cosim("check", scene, &[set], LIMIT);
         refused(&out, set, &[key, value]);
+    }
+}
+
+/// A value of 1e300 reads `1e300` in the refusal, not as its 301 digits (found 2026-12-06: a Young's modulus of
+/// −1e300 was refused with a 300-digit number, a run of 1e300 s "needed about" a 283-digit number of EiB).
+#[test]
+fn extreme_values_are_said_in_scientific_notation() {
+    for (set, said) in [
+        ("solid[0].material.youngs_modulus=-1e300", "got -1e300"),
+        ("fluid.cfl=1e300", "got 1e300"),
+        ("run.end_time=1e300", "1.1e286 EiB of memory"),
+        ("fluid.spacing=1e-300", "fluid.spacing: 1e-300 m makes"),
+    ] {
+        let out = cosim("check", "scenes/elastic_gate.toml", &[set], LIMIT);
+        let line = refused(&out, set, &[said]);
+        assert!(line.len() < 400, "{set}: {} characters: {line}", line.len());
     }
 }
 

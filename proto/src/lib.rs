@@ -7,11 +7,13 @@ pub mod envelope;
 pub mod keys;
 pub mod messages;
 pub mod overlap;
+pub mod readable;
 pub mod run_status;
 pub mod scene;
 pub mod trace;
 pub mod validate;
 
+pub use readable::Num;
 pub use scene::sizing;
 
 pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

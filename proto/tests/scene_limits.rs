@@ -169,7 +169,7 @@ fn ids_beyond_u32_are_refused_naming_the_key() {
     assert_eq!(MAX_COUNT, 4294967295.0);
     let line = err(DAM, &["fluid.spacing=1e-6"]);
     assert!(
-        line.starts_with("f.toml: fluid.spacing: 0.000001 m makes 2.97e10 fluid and wall particles (2.00e10 fluid)"),
+        line.starts_with("f.toml: fluid.spacing: 1e-6 m makes 2.97e10 fluid and wall particles (2.00e10 fluid)"),
         "{line}"
     );
     assert!(
@@ -201,7 +201,7 @@ fn memory_refusal_names_the_key_that_takes_most() {
     let (key, message) = Sizing::of(&big).refuse_above(Part::Run, gib).unwrap_err();
     assert_eq!(key, "fluid.spacing");
     assert!(
-        message.starts_with("0.00002 m fills the fluid blocks with 5.00e7 particles: the run needs about"),
+        message.starts_with("2e-5 m fills the fluid blocks with 5.00e7 particles: the run needs about"),
         "{message}"
     );
     assert!(message.ends_with("this machine has 1.0 GiB available"), "{message}");
@@ -222,7 +222,7 @@ fn memory_refusal_names_the_key_that_takes_most() {
         .unwrap_err();
     assert_eq!(key, "run.output_interval");
     assert!(
-        message.starts_with("0.000000001 s samples 1 probe(s) 1.00e9 times"),
+        message.starts_with("1e-9 s samples 1 probe(s) 1.00e9 times"),
         "{message}"
     );
 }

@@ -61,14 +61,14 @@ pub fn replay(args: &ReplayArgs) -> anyhow::Result<ExitCode> {
         anyhow::ensure!(
             t.rtol >= 0.0 && t.atol >= 0.0 && t.rtol.is_finite() && t.atol.is_finite(),
             "--rtol and --atol must be finite and not negative, got {} and {}",
-            t.rtol,
-            t.atol
+            cosim_proto::Num(t.rtol),
+            cosim_proto::Num(t.atol)
         );
     }
     anyhow::ensure!(
         args.timeout.is_finite() && args.timeout > 0.0,
         "--timeout must be a positive number of seconds, got {}",
-        args.timeout
+        cosim_proto::Num(args.timeout)
     );
     let script = script::read(&args.trace, args.node)?;
     if let Some(torn) = &script.torn {

@@ -9,6 +9,7 @@
 //! coupling step (at `coupling.max_dt` 1e-4: 0.009 at 4.4, 0.053 at 14.5, 0.44 at 58).
 
 use super::schema::{ContactAlgorithm, FluidSolver, Scene, SolidSpec};
+use crate::Num;
 
 /// The ratio above which `cosim check` and `cosim run` warn: between the gate's 28 (a gain of 0.019 with WCSPH) and
 /// 58 (0.106).
@@ -67,11 +68,12 @@ impl Scene {
             .filter(|&(_, ratio)| ratio > HEAVY_PARTICLE)
             .map(|(name, ratio)| {
                 format!(
-                    "a fluid particle weighs {ratio:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
+                    "a fluid particle weighs {:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
                      the solid's divisions, refine fluid.spacing, damp the ringing ({}.mesh_damping = 0.25) or spread \
                      the load (contact.load_spread = 2; docs/CORRECTIONS.md)",
+                    Num(ratio),
                     self.solid_key(name)
                 )
             })
@@ -86,11 +88,12 @@ impl Scene {
         let (name, ratio) = self.heaviest_particle()?;
         (k > 1 && ratio > SUBSTEP_RATIO).then(|| {
             format!(
-                "coupling.fluid_substeps = {} against solid `{name}`, whose cells a fluid particle outweighs {ratio:.1} \
+                "coupling.fluid_substeps = {} against solid `{name}`, whose cells a fluid particle outweighs {:.1} \
                  times (above {SUBSTEP_RATIO:.0}): a contact pass every {k} fluid steps rings a mesh that fine (the 4 mm \
                  gate, 14.5 cells, gained 0.05-0.08 of the water's releasable energy at 2-4 against 0.0014 in lockstep); \
                  set coupling.fluid_substeps = 1 (docs/CORRECTIONS.md)",
-                self.coupling.fluid_substeps
+                self.coupling.fluid_substeps,
+                Num(ratio)
             )
         })
     }
@@ -109,11 +112,12 @@ impl Scene {
         (isph && ratio >= LONG_STEP_RATIO && fem_steps >= LONG_COUPLING_STEP).then(|| {
             format!(
                 "with ISPH the coupling step ({coupling_dt:.2e} s) spans {fem_steps} FE steps of the structure, and a \
-                 fluid particle weighs {ratio:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
+                 fluid particle weighs {:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
                  step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
                  free, made the 4 mm gate unstable without a bound from the structure's speed); try coupling.max_dt = \
                  {:.0e}, or damp the structure's ringing ({}.mesh_damping = 0.25: the 4 mm gate then ends at ISPH's own \
                  step; docs/CORRECTIONS.md){}",
+                Num(ratio),
                 24.0 * fem_dt,
                 self.solid_key(name),
                 match self.contact.algorithm {

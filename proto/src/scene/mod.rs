@@ -11,6 +11,7 @@
 //!
 //! Everything is re-exported here, so users name `cosim_proto::scene::Scene`, `cosim_proto::scene::parse`, ….
 
+pub mod disk;
 mod grid;
 mod load;
 mod mass_ratio;

@@ -12,6 +12,7 @@
 //! good to some tens of per cent: enough to tell a run that fits from one that cannot.
 
 use super::schema::{BoxSpec, ElementKind, FluidSolver, Scene, SolidSpec};
+use crate::Num;
 
 /// Most particles (fluid and walls together), FE nodes, FE elements or neighbour-grid cells a run may have: their
 /// ids are `u32` on the wire (`docs/PROTOCOL.md`) and in the solvers' lists.
@@ -179,10 +180,10 @@ impl Sizing {
             s.fluid_particles = f.blocks.iter().map(|b| block_particles(b, dx)).sum();
             let n = s.fluid_particles;
             s.add([n * per_particle, 0.0, n * BROKER_PARTICLE_BYTES, 0.0], || {
-                let what = format!("{dx} m fills the fluid blocks with {} particles", count(n));
+                let what = format!("{} m fills the fluid blocks with {} particles", Num(dx), count(n));
                 ("fluid.spacing".into(), what)
             });
-            s.particle_key = Some(("fluid.spacing".into(), format!("{dx} m")));
+            s.particle_key = Some(("fluid.spacing".into(), format!("{} m", Num(dx))));
             let origin = f.blocks.first().map_or([0.0; 2], |b| b.min);
             let mut largest_wall = 0.0;
             for (w, wall) in scene.walls.iter().enumerate() {
@@ -190,7 +191,10 @@ impl Sizing {
                 s.wall_particles += n;
                 s.add([n * per_wall, 0.0, n * BROKER_WALL_BYTES, 0.0], || {
                     let (min, max, n) = (wall.min, wall.max, count(n));
-                    let what = format!("min {min:?} max {max:?} holds {n} wall particles at a spacing of {dx} m");
+                    let what = format!(
+                        "min {min:?} max {max:?} holds {n} wall particles at a spacing of {} m",
+                        Num(dx)
+                    );
                     (format!("wall[{w}]"), what)
                 });
                 if n > largest_wall {
@@ -245,7 +249,7 @@ impl Sizing {
                 "run.output_interval".to_string(),
                 format!(
                     "{} s samples {} probe(s) {} times",
-                    scene.run.output_interval,
+                    Num(scene.run.output_interval),
                     count(probes),
                     count(frames)
                 ),
@@ -431,12 +435,13 @@ fn grid(blocks: &[BoxSpec], walls: &[BoxSpec], dx: f64, h: f64) -> (f64, String,
     };
     let all = cells(usize::MAX);
     let what = format!(
-        "the fluid's neighbour grid over x {} to {} m, y {} to {} m has {} cells of 2h = {cell} m",
-        lo[0].0,
-        hi[0].0,
-        lo[1].0,
-        hi[1].0,
-        count(all)
+        "the fluid's neighbour grid over x {} to {} m, y {} to {} m has {} cells of 2h = {} m",
+        Num(lo[0].0),
+        Num(hi[0].0),
+        Num(lo[1].0),
+        Num(hi[1].0),
+        count(all),
+        Num(cell)
     );
     let (shrink, far) = [lo[0].2, lo[1].2, hi[0].2, hi[1].2]
         .into_iter()
@@ -462,15 +467,9 @@ pub fn count(n: f64) -> String {
     }
 }
 
-/// A value as it reads best in a message: as written between 1e-4 and 1e7, in scientific notation beyond (a
-/// `coupling.max_dt` of 1e-300 is not 300 zeros).
+/// A value as it reads best in a message ([`crate::Num`]): a `coupling.max_dt` of 1e-300 is not 300 zeros.
 pub fn number(x: f64) -> String {
-    let a = x.abs();
-    if a == 0.0 || !a.is_finite() || (1e-4..1e7).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
+    crate::Num(x).to_string()
 }
 
 /// Bytes in binary units (KiB, MiB, GiB, TiB, …).
@@ -486,6 +485,6 @@ pub fn bytes_text(bytes: f64) -> String {
     }
     match u {
         0 => format!("{v:.0} B"),
-        _ => format!("{v:.1} {}", UNITS[u]),
+        _ => format!("{:.1} {}", Num(v), UNITS[u]),
     }
 }

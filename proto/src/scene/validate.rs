@@ -4,12 +4,12 @@
 use std::collections::HashSet;
 
 use super::schema::{
-    BoxSpec, ContactAlgorithm, DensityFilter, FluidSolver, FluidSpec, ProbeKind, Scene, SolidSpec, FLUID_SUBSTEPS_MAX,
-    ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION, STRUCTURE_COURANT_MIN,
+    ContactAlgorithm, FluidSolver, ProbeKind, Scene, FLUID_SUBSTEPS_MAX, SCENE_VERSION, STRUCTURE_COURANT_MIN,
 };
 use super::sizing::Sizing;
-use crate::overlap;
+use crate::{overlap, Num};
 
+mod fluid;
 mod probe_point;
 mod solid;
 
@@ -27,154 +27,8 @@ fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
     check(
         v.is_finite() && v > 0.0,
         || key.to_string(),
-        || format!("must be a positive number, got {v}"),
+        || format!("must be a positive number, got {}", Num(v)),
     )
-}
-
-/// The fluid section: positive sizes, a sensible smoothing ratio, blocks that hold particles and stay out of walls.
-fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Result<(), Invalid> {
-    finite_positive("fluid.density", f.density)?;
-    finite_positive("fluid.spacing", f.spacing)?;
-    check(
-        f.kinematic_viscosity.is_finite() && f.kinematic_viscosity >= 0.0,
-        || "fluid.kinematic_viscosity".into(),
-        || format!("must be zero or positive, got {}", f.kinematic_viscosity),
-    )?;
-    check(
-        (1.0..=2.0).contains(&f.smoothing_ratio),
-        || "fluid.smoothing_ratio".into(),
-        || format!("must be in [1, 2] (h = ratio x spacing), got {}", f.smoothing_ratio),
-    )?;
-    if let Some(c) = f.sound_speed {
-        finite_positive("fluid.sound_speed", c)?;
-    }
-    check(
-        f.cfl.is_finite() && f.cfl > 0.0 && f.cfl <= 1.0,
-        || "fluid.cfl".into(),
-        || {
-            format!(
-                "must be in (0, 1] (a factor on the stable step of DESIGN.md §4.2/§4.3; above 1 the fluid is \
-                 stepped past its stability limit), got {}",
-                f.cfl
-            )
-        },
-    )?;
-    check(
-        f.artificial_viscosity.is_finite() && f.artificial_viscosity >= 0.0,
-        || "fluid.artificial_viscosity".into(),
-        || format!("must be zero or positive, got {}", f.artificial_viscosity),
-    )?;
-    check(
-        f.density_filter_interval >= 1,
-        || "fluid.density_filter_interval".into(),
-        || "must be at least 1".into(),
-    )?;
-    check(
-        f.xsph.is_finite() && (0.0..=1.0).contains(&f.xsph),
-        || "fluid.xsph".into(),
-        || format!("must be in [0, 1], got {}", f.xsph),
-    )?;
-    check(
-        f.apd().is_finite() && (0.0..=1.0).contains(&f.apd()),
-        || "fluid.apd".into(),
-        || format!("must be in [0, 1], got {}", f.apd()),
-    )?;
-    check(
-        f.density_diffusion.is_finite() && (0.0..=1.0).contains(&f.density_diffusion),
-        || "fluid.density_diffusion".into(),
-        || {
-            format!(
-                "must be in [0, 1] (δ of δ-SPH; 0.1 is usual), got {}",
-                f.density_diffusion
-            )
-        },
-    )?;
-    check(
-        f.verlet_skin().is_finite() && (0.0..=1.0).contains(&f.verlet_skin()),
-        || "fluid.verlet_skin".into(),
-        || {
-            format!(
-                "must be in [0, 1] (units of h; 0 searches every step), got {}",
-                f.verlet_skin()
-            )
-        },
-    )?;
-    check(
-        f.verlet_skin.is_none() || f.solver == FluidSolver::Wcsph,
-        || "fluid.verlet_skin".into(),
-        || "applies to solver = \"wcsph\" only (the ISPH search runs every step)".into(),
-    )?;
-    check(
-        f.density_diffusion == 0.0 || f.solver == FluidSolver::Wcsph,
-        || "fluid.density_diffusion".into(),
-        || "applies to solver = \"wcsph\" only (ISPH takes its pressure from the Poisson equation)".into(),
-    )?;
-    if f.solver == FluidSolver::Isph {
-        check(
-            f.density_filter() == DensityFilter::None,
-            || "fluid.density_filter".into(),
-            || "ISPH takes no density filter (its pressure comes from the Poisson equation); set \"none\"".into(),
-        )?;
-        check(
-            f.ppe_tolerance().is_finite() && ISPH_PPE_TOLERANCE_RANGE.contains(&f.ppe_tolerance()),
-            || "fluid.ppe_tolerance".into(),
-            || {
-                format!(
-                    "must be in [{:e}, {:e}] (the pressure solve's relative residual), got {}",
-                    ISPH_PPE_TOLERANCE_RANGE.start(),
-                    ISPH_PPE_TOLERANCE_RANGE.end(),
-                    f.ppe_tolerance()
-                )
-            },
-        )?;
-    } else {
-        for (set, key) in [
-            (f.ppe_source.is_some(), "fluid.ppe_source"),
-            (f.ppe_tolerance.is_some(), "fluid.ppe_tolerance"),
-        ] {
-            check(!set, || key.into(), || "applies to solver = \"isph\" only".into())?;
-        }
-    }
-    check(
-        !f.blocks.is_empty(),
-        || "fluid.block".into(),
-        || "at least one [[fluid.block]] is needed".into(),
-    )?;
-    for (b, block) in f.blocks.iter().enumerate() {
-        let key = || format!("fluid.block[{b}]");
-        check(
-            (0..2).all(|k| block.min[k].is_finite() && block.max[k].is_finite()),
-            key,
-            || "corners must be finite".into(),
-        )?;
-        check((0..2).all(|k| block.max[k] - block.min[k] >= f.spacing), key, || {
-            format!(
-                "holds no particle: min {:?} max {:?} is narrower than the spacing {}",
-                block.min, block.max, f.spacing
-            )
-        })?;
-        for (w, wall) in walls.iter().enumerate() {
-            // Overlap of more than half a spacing in both directions: particles would sit inside the wall.
-            let overlap =
-                (0..2).all(|k| block.max[k].min(wall.max[k]) - block.min[k].max(wall.min[k]) > 0.5 * f.spacing);
-            check(!overlap, key, || {
-                format!("overlaps wall[{w}] (min {:?} max {:?})", wall.min, wall.max)
-            })?;
-        }
-        for solid in solids {
-            // The same rule against a solid's rectangle: particles inside a structure would be pushed out by
-            // the contact in the first step, with an impulse no physics asked for.
-            let overlap =
-                (0..2).all(|k| block.max[k].min(solid.max[k]) - block.min[k].max(solid.min[k]) > 0.5 * f.spacing);
-            check(!overlap, key, || {
-                format!(
-                    "overlaps solid `{}` (min {:?} max {:?})",
-                    solid.name, solid.min, solid.max
-                )
-            })?;
-        }
-    }
-    Ok(())
 }
 
 impl Scene {
@@ -215,9 +69,10 @@ impl Scene {
                 || "run.frame_interval".into(),
                 || {
                     format!(
-                        "{f} s is not a whole multiple of run.output_interval ({} s): frames are written at output \
+                        "{} s is not a whole multiple of run.output_interval ({} s): frames are written at output \
                          times",
-                        self.run.output_interval
+                        Num(f),
+                        Num(self.run.output_interval)
                     )
                 },
             )?;
@@ -233,7 +88,7 @@ impl Scene {
             // Above 0.94 elongated tri3 meshes go unstable (their characteristic length is an estimate).
             self.coupling.fem_cfl > 0.0 && self.coupling.fem_cfl <= 0.9,
             || "coupling.fem_cfl".into(),
-            || format!("must be in (0, 0.9], got {}", self.coupling.fem_cfl),
+            || format!("must be in (0, 0.9], got {}", Num(self.coupling.fem_cfl)),
         )?;
         check(
             self.coupling.structure_courant == 0.0
@@ -242,7 +97,7 @@ impl Scene {
             || {
                 format!(
                     "must be 0 (no bound from the structure's speed) or in [0.001, 1], got {}",
-                    crate::scene::sizing::number(self.coupling.structure_courant)
+                    Num(self.coupling.structure_courant)
                 )
             },
         )?;
@@ -267,13 +122,18 @@ impl Scene {
         check(
             self.contact.load_spread.is_finite() && (0.0..=4.0).contains(&self.contact.load_spread),
             || "contact.load_spread".into(),
-            || format!("must be in [0, 4] fluid spacings, got {}", self.contact.load_spread),
+            || {
+                format!(
+                    "must be in [0, 4] fluid spacings, got {}",
+                    Num(self.contact.load_spread)
+                )
+            },
         )?;
         if let Some(w) = self.contact.reaction_relaxation {
             check(
                 w > 0.0 && w <= 1.0,
                 || "contact.reaction_relaxation".into(),
-                || format!("must be in (0, 1], got {w}"),
+                || format!("must be in (0, 1], got {}", Num(w)),
             )?;
             check(
                 self.contact.algorithm == ContactAlgorithm::ParticleParticle,
@@ -287,7 +147,7 @@ impl Scene {
             )?;
         }
         if let Some(fluid) = &self.fluid {
-            validate_fluid(fluid, &self.walls, &self.solids)?;
+            fluid::validate_fluid(fluid, &self.walls, &self.solids)?;
             // c0 defaults to 10 sqrt(2 g H) (`sph_node::setup::sound_speed`): WCSPH always needs it, ISPH for the
             // `particle_particle` force. Without gravity there is no default, and the fluid node failed at start
             // where `cosim check` refused (found 2026-12-06).
@@ -354,7 +214,7 @@ impl Scene {
             check(
                 probe.x_max.is_none_or(f64::is_finite),
                 || key("x_max"),
-                || format!("must be finite, got {}", probe.x_max.unwrap_or_default()),
+                || format!("must be finite, got {}", Num(probe.x_max.unwrap_or_default())),
             )?;
             if let Some(name) = &probe.solid {
                 check(
@@ -429,8 +289,10 @@ impl Scene {
                             || key("x_max"),
                             || {
                                 format!(
-                                    "{x_max} is left of every fluid particle (the first are at x = {first}): the \
-                                     column would be empty from the start"
+                                    "{} is left of every fluid particle (the first are at x = {}): the column \
+                                     would be empty from the start",
+                                    Num(x_max),
+                                    Num(first)
                                 )
                             },
                         )?;
@@ -453,7 +315,7 @@ impl Scene {
                 check(
                     r.is_finite() && r >= 0.0,
                     || key("radius"),
-                    || format!("must be a finite length >= 0, got {r}"),
+                    || format!("must be a finite length >= 0, got {}", Num(r)),
                 )?;
                 let n = probe.normal.unwrap_or([0.0, 0.0]);
                 check(
@@ -471,7 +333,7 @@ impl Scene {
                     check(
                         v.is_finite(),
                         || key(&format!("reference.{k}")),
-                        || format!("must be finite, got {v}"),
+                        || format!("must be finite, got {}", Num(v)),
                     )?;
                 }
             }

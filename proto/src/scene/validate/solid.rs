@@ -2,6 +2,7 @@
 
 use super::{check, finite_positive, Invalid};
 use crate::scene::schema::SolidSpec;
+use crate::Num;
 
 /// `solid[s]`, in file order; the first problem found as its dotted key and one line.
 pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid> {
@@ -34,12 +35,12 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
     check(
         m.poisson_ratio.is_finite() && (0.0..0.5).contains(&m.poisson_ratio),
         || key("material.poisson_ratio"),
-        || format!("must be in [0, 0.5), got {}", m.poisson_ratio),
+        || format!("must be in [0, 0.5), got {}", Num(m.poisson_ratio)),
     )?;
     check(
         solid.damping.is_finite() && solid.damping >= 0.0,
         || key("damping"),
-        || format!("must be zero or positive, got {}", solid.damping),
+        || format!("must be zero or positive, got {}", Num(solid.damping)),
     )?;
     check(
         solid.mesh_damping.is_finite() && (0.0..1.0).contains(&solid.mesh_damping),
@@ -47,7 +48,7 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
         || {
             format!(
                 "must be in [0, 1) (the damping ratio of the mesh's highest mode), got {}",
-                solid.mesh_damping
+                Num(solid.mesh_damping)
             )
         },
     )?;
