@@ -69,7 +69,7 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
         )
         .map(|(s, _)| s),
     }
-    .map_err(|e| anyhow::anyhow!("cannot reach run `{id}` at {connect}: {e:#}"))?;
+    .map_err(|e| anyhow::anyhow!("cannot reach run `{id}` at {connect} within {} s: {e:#}", how.timeout))?;
     // Let zenoh learn the run's queryables (gossip) before the first question.
     std::thread::sleep(Duration::from_millis(1500));
     Ok((session, connect))

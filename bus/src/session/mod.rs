@@ -129,7 +129,10 @@ pub fn open_router(base: Option<&Path>, listen: &[String], timeout_ms: u64) -> a
     })
 }
 
-/// Call `open` with `listen` made concrete ([`concrete`]), up to five times while it fails.
+/// Call `open` with `listen` made concrete ([`concrete`]), up to five times while it fails because another
+/// program took a port picked here. Any other failure (a connect endpoint that does not answer within the timeout)
+/// is returned at once: it would fail the same way again, each time after the whole timeout (`cosim ctl` on a
+/// closed port took 5 × 10 s).
 fn retry_ports(
     listen: &[String],
     mut open: impl FnMut(&[String]) -> anyhow::Result<Session>,
@@ -141,12 +144,21 @@ fn retry_ports(
             Ok(session) => return Ok((session, endpoints)),
             Err(e) => last = Some(e),
         }
-        // A fixed port that failed fails the same way again.
-        if endpoints == listen {
+        // A fixed port that failed fails the same way again; a picked one is tried again only if it was taken.
+        let picked = endpoints.iter().zip(listen).filter(|(e, l)| e != l);
+        if !picked.into_iter().any(|(e, _)| taken(e)) {
             break;
         }
     }
     Err(last.expect("at least one attempt"))
+}
+
+/// Whether the TCP port of `endpoint` (`tcp/HOST:PORT` or `tls/HOST:PORT`) is bound by another program now.
+fn taken(endpoint: &str) -> bool {
+    let Some((_, address)) = endpoint.split_once('/') else {
+        return false;
+    };
+    std::net::TcpListener::bind(address).is_err()
 }
 
 /// `tcp/HOST:0` (or `tls/HOST:0`) with a free port of HOST; other endpoints unchanged.
@@ -164,5 +176,35 @@ fn concrete(endpoint: &str) -> anyhow::Result<String> {
             Ok(format!("{scheme}/{host}:{port}"))
         }
         None => Ok(endpoint.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A failure with the picked port still free (what a connect endpoint that does not answer gives) is not tried
+    /// again; one whose picked port another program holds is, with a new port each time.
+    #[test]
+    fn only_a_taken_port_is_tried_again() {
+        let mut tried = Vec::new();
+        let err = retry_ports(&["tcp/127.0.0.1:0".to_string()], |endpoints| {
+            tried.push(endpoints.to_vec());
+            anyhow::bail!("Unable to connect to any of [tcp/127.0.0.1:9]. Timeout!")
+        })
+        .unwrap_err();
+        assert_eq!(tried.len(), 1, "{tried:?}");
+        assert!(err.to_string().contains("Unable to connect"), "{err}");
+
+        let mut held = Vec::new();
+        let _ = retry_ports(&["tcp/127.0.0.1:0".to_string()], |endpoints| {
+            // Another program binds the port picked for us before we do.
+            let address = endpoints[0].strip_prefix("tcp/").unwrap();
+            held.push(std::net::TcpListener::bind(address).unwrap());
+            anyhow::bail!("Can not create a new TCP listener bound to {address}")
+        });
+        assert_eq!(held.len(), 5, "tried five times while the port was taken");
+        let ports: std::collections::HashSet<_> = held.iter().map(|l| l.local_addr().unwrap().port()).collect();
+        assert_eq!(ports.len(), 5, "a new port each time");
     }
 }
