@@ -211,6 +211,13 @@ fn serve(
         Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
         None => None,
     };
+    // Ctrl-C during a long step: the wait for the nodes' answers is given up, the outputs so far written.
+    if let Some(link) = fem.as_mut() {
+        link.stop_on(interrupt.clone());
+    }
+    if let Some(link) = sph.as_mut() {
+        link.stop_on(interrupt.clone());
+    }
     if let Some(r) = recorder {
         let tap = |node| Tap {
             recorder: r.clone(),

@@ -19,6 +19,7 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
+use cosim_bus::interrupt::{Interrupt, REASON};
 use cosim_bus::link_loss;
 use cosim_proto::trace::Kind;
 
@@ -110,6 +111,8 @@ pub struct ZenohLink<S, T> {
     registration: (u64, Vec<u8>),
     /// Where every message sent and accepted is recorded (`--record`).
     tap: Option<Tap>,
+    /// Ctrl-C or SIGTERM: a wait for an answer that still goes on [`STOP_WAIT`] after it is given up.
+    stop: Option<Interrupt>,
     _state: std::marker::PhantomData<T>,
 }
 
@@ -198,6 +201,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             last_command: None,
             registration,
             tap: None,
+            stop: None,
             _state: std::marker::PhantomData,
         })
     }
@@ -206,6 +210,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     pub fn record_to(&mut self, tap: Tap) {
         tap.record(Kind::Setup, self.registration.0, &self.registration.1);
         self.tap = Some(tap);
+    }
+
+    /// Give up waiting for an answer [`STOP_WAIT`] after `interrupt` arrived: a run whose coupling step takes
+    /// minutes (a fine mesh) then stops with its outputs so far written, instead of being killed by `cosim run`
+    /// with none (10 s after the Ctrl-C). A step that ends within that time is still taken.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.stop = Some(interrupt);
     }
 
     fn failed(&self, message: impl Into<String>) -> LinkError {
@@ -278,6 +289,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
 /// answers it from its zenoh threads whatever it is computing, within milliseconds; one that is gone (a failed run)
 /// costs the whole wait.
 const COUNTS_TIMEOUT: Duration = Duration::from_millis(500);
+
+/// How long a wait for a node's answer goes on after Ctrl-C or SIGTERM ([`ZenohLink::stop_on`]): well within the
+/// 10 s `cosim run` gives the broker to stop before it kills it.
+const STOP_WAIT: Duration = Duration::from_secs(2);
 
 impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S, T> {
     type Setup = S;
@@ -381,6 +396,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         // A message that is not this run's answer to this step (malformed, another version, run or step) is
         // refused: logged, never applied, and the wait goes on (`docs/PROTOCOL.md` §7).
         let mut refused: Option<String> = None;
+        let mut stopped_at: Option<Instant> = None;
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
@@ -409,6 +425,16 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                 Err(e) => return Err(self.failed(format!("state channel closed: {e}"))),
             }
             self.check_node()?;
+            if self.stop.as_ref().is_some_and(Interrupt::arrived) {
+                let at = *stopped_at.get_or_insert_with(Instant::now);
+                if at.elapsed() > STOP_WAIT {
+                    return Err(self.failed(format!(
+                        "still computing coupling step {step} after {:.1} s, {:.0} s after the signal: {REASON}",
+                        started.elapsed().as_secs_f64(),
+                        at.elapsed().as_secs_f64()
+                    )));
+                }
+            }
             if Instant::now() > resend_at && Instant::now() < deadline {
                 resend_at += resend_every;
                 if let Some((_, _, bytes)) = self.last_command.as_ref().filter(|(s, _, _)| *s == step) {

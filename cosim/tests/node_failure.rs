@@ -41,16 +41,21 @@ fn start(name: &str) -> Started {
 
 /// [`start`], or in one process (`--in-process`: no children; it waits for the samples only).
 fn start_with(name: &str, in_process: bool) -> Started {
+    start_run(name, SCENE, &SETS, in_process, if in_process { 0 } else { 3 }, 3)
+}
+
+/// Starts `scene` with `sets` and waits until `processes` children run and `at_least` probe samples are written.
+fn start_run(name: &str, scene: &str, sets: &[&str], in_process: bool, processes: usize, at_least: usize) -> Started {
     let dir = scratch(&format!("failure-{name}"));
     let out = dir.join("out");
     let stderr_path = dir.join("stderr.txt");
     let mut cmd = Command::new(cosim());
     cmd.current_dir(root())
         .env("COSIM_BIN_DIR", bin_dir())
-        .args(["run", SCENE, "--quiet", "--out"])
+        .args(["run", scene, "--quiet", "--out"])
         .arg(&out)
         .args(["--run-id", &run_id(name)]);
-    for s in SETS {
+    for s in sets {
         cmd.args(["--set", s]);
     }
     if in_process {
@@ -66,7 +71,7 @@ fn start_with(name: &str, in_process: bool) -> Started {
     let started = Instant::now();
     let kids = loop {
         let kids = children(run.0.id());
-        if kids.len() == if in_process { 0 } else { 3 } && samples(&out) >= 3 {
+        if kids.len() == processes && samples(&out) >= at_least {
             break kids;
         }
         assert!(run.0.try_wait().unwrap().is_none(), "the run ended early");
@@ -180,6 +185,55 @@ fn interrupted() {
         assert!(out.join("frames").read_dir().unwrap().count() >= 3);
         assert_all_gone(&kids);
     }
+}
+
+/// Ctrl-C during a coupling step of minutes (csm3 with a 1 × 30,000 mesh: 182,575 FE steps of 30,000 elements a
+/// coupling step): the broker gives up its wait for the structure's answer 2 s after the signal and ends the run
+/// with its outputs so far (the sample and frame at t = 0, the plots), naming the step and the signal; the node
+/// still computing goes with it. Before, `cosim run` killed the broker 10 s after the Ctrl-C: "contact-broker died
+/// (signal 9); (no message)", no plots.
+#[test]
+fn interrupted_during_a_long_step() {
+    let sets = ["solid[0].divisions=[1,30000]"];
+    let Started {
+        mut run,
+        out,
+        stderr_path,
+        kids,
+        _dir,
+    } = start_run("interrupted_long_step", "scenes/csm3.toml", &sets, false, 2, 1);
+    // Well into coupling step 1.
+    std::thread::sleep(Duration::from_secs(1));
+    let hit = Instant::now();
+    let sent = Command::new("kill")
+        .args(["-INT", &run.0.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let status = wait_exit(&mut run.0, hit + LIMIT, "cosim after SIGINT");
+    let took = hit.elapsed();
+    let stderr = std::fs::read_to_string(&stderr_path).unwrap();
+    eprintln!("cosim exited {took:.2?} after SIGINT: {}", stderr.trim());
+    assert_eq!(status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
+    for word in [
+        "fem-node: still computing coupling step 1",
+        "interrupted (SIGINT or SIGTERM)",
+    ] {
+        assert!(lines[0].contains(word), "{word:?} not in {stderr}");
+    }
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    assert!(
+        summary["message"].as_str().unwrap().contains("interrupted"),
+        "{summary}"
+    );
+    assert_eq!(summary["samples"], 1, "{summary}");
+    assert_eq!(samples(&out), 1);
+    assert!(out.join("plots/tip_ux.svg").is_file(), "no plot written");
+    assert!(out.join("frames/structure_00000.vtu").is_file(), "no frame written");
+    assert_all_gone(&kids);
 }
 
 /// `cosim run` itself killed with SIGKILL (it runs no clean-up): the broker finds its progress pipe closed, stops
