@@ -8,11 +8,15 @@ use cosim_proto::scene::sizing::Sizing;
 use cosim_proto::scene::{Scene, SceneError};
 
 /// Bytes an unprivileged writer may still use on the disk that holds `dir` (the disk of its nearest existing
-/// ancestor: the folder may not exist yet), or `None` where it cannot be read: then no run is refused for it.
+/// ancestor: the folder may not exist yet), or `None` where it cannot be read, or where the file system counts no
+/// blocks at all (`/proc`, `/sys`: then creating the folder fails with its own error): then no run is refused for it.
 pub fn free(dir: &Path) -> Option<u64> {
     let absolute = std::path::absolute(dir).ok()?;
     let existing = absolute.ancestors().find(|p| p.exists())?;
     let stat = rustix::fs::statvfs(existing).ok()?;
+    if stat.f_blocks == 0 {
+        return None;
+    }
     stat.f_bavail.checked_mul(stat.f_frsize)
 }
 
@@ -52,6 +56,15 @@ mod tests {
         let later = free_of_missing(&here);
         // The same disk: the same free space, to what other processes wrote in between (64 MiB).
         assert!(later.abs_diff(free) < 64 << 20, "{later} against {free}");
+    }
+
+    /// A file system without blocks (`/proc`) has no free space to compare with: a folder there fails when it is
+    /// made, with its own error, not as "0 B free".
+    #[test]
+    fn a_file_system_without_blocks_has_no_free_space_to_refuse_for() {
+        if Path::new("/proc/self").exists() {
+            assert_eq!(free(Path::new("/proc/nope/x")), None);
+        }
     }
 
     fn free_of_missing(here: &Path) -> u64 {

@@ -373,3 +373,56 @@ fn external_node_refused_where_it_cannot_join_and_a_missing_one_fails_within_sec
     assert!(started.elapsed() < Duration::from_secs(20), "{:?}", started.elapsed());
     assert_eq!(json(&out_dir.join("summary.json"))["status"], "failed");
 }
+
+/// An output folder that holds the user's own files is never cleared: a run clears `frames/`, `plots/` and `logs/`
+/// of its folder, so `--out` at a project folder is refused (exit 2, one line naming the folder and what it holds),
+/// and everything in it stays. An earlier run's folder (it has the run's `summary.json`) and an empty one are taken.
+/// Found 2026-12-06: `--out /tmp/proj` deleted `proj/logs/notes.txt`, and `--out /` wrote into the root.
+#[test]
+fn a_folder_of_the_users_is_never_cleared() {
+    let dir = scratch("bad-out-folder");
+    let project = dir.join("project");
+    std::fs::create_dir_all(project.join("logs")).unwrap();
+    std::fs::create_dir_all(project.join("plots")).unwrap();
+    std::fs::write(project.join("logs/notes.txt"), "mine").unwrap();
+    std::fs::write(project.join("plots/figure.svg"), "<svg/>").unwrap();
+    let run = |out: &std::path::Path| {
+        let mut cmd = Command::new(cosim());
+        cmd.current_dir(root())
+            .env("COSIM_BIN_DIR", bin_dir())
+            .args([
+                "run",
+                "scenes/csm3.toml",
+                "--quiet",
+                "--set",
+                "run.end_time=0.01",
+                "--out",
+            ])
+            .arg(out);
+        run_bounded(&mut cmd, LIMIT)
+    };
+    let out = run(&project);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "--out {}: the folder holds `logs`, `plots` and no summary.json",
+            project.display()
+        )),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(project.join("logs/notes.txt")).unwrap(), "mine");
+    assert_eq!(
+        std::fs::read_to_string(project.join("plots/figure.svg")).unwrap(),
+        "<svg/>"
+    );
+    assert!(!project.join("summary.json").exists());
+    // A new folder, then the same folder again (an earlier run's, its frames replaced).
+    let fresh = dir.join("fresh");
+    for _ in 0..2 {
+        let out = run(&fresh);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(json(&fresh.join("summary.json"))["status"], "ok");
+    }
+}

@@ -16,7 +16,7 @@ use super::suite::Case;
 /// File the child writes its [`ProcessStats`] to, in its output folder.
 pub const STATS_FILE: &str = "bench_process.json";
 /// The child's stdout and stderr, in its output folder.
-const LOG_FILE: &str = "bench.log";
+pub const LOG_FILE: &str = "bench.log";
 
 /// Run `case` with its outputs in `out`; `scenes` holds the reference data. Never fails: a case that cannot run
 /// is a record with status `failed` or `timeout`.
