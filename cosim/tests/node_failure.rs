@@ -101,6 +101,31 @@ fn assert_all_gone(kids: &[(u32, String)]) {
     assert!(left.is_empty(), "left running: {left:?}");
 }
 
+/// Sends `signal` to process `pid`, waits for `cosim run` to exit, and asserts exit 1 with one line on stderr that
+/// says each of `words`; returns the time it took and the line.
+fn signal_and_expect(
+    run: &mut Kill,
+    pid: u32,
+    signal: &str,
+    stderr_path: &std::path::Path,
+    words: &[&str],
+) -> (Duration, String) {
+    let hit = Instant::now();
+    let sent = Command::new("kill").args([signal, &pid.to_string()]).status().unwrap();
+    assert!(sent.success());
+    let status = wait_exit(&mut run.0, hit + LIMIT, &format!("cosim after {signal} to {pid}"));
+    let took = hit.elapsed();
+    let stderr = std::fs::read_to_string(stderr_path).unwrap();
+    eprintln!("cosim exited {took:.2?} after {signal} to {pid}: {}", stderr.trim());
+    assert_eq!(status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
+    for word in words {
+        assert!(lines[0].contains(word), "{word:?} not in {stderr}");
+    }
+    (took, lines[0].to_string())
+}
+
 /// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
 fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
     let Started {
@@ -115,22 +140,8 @@ fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
         .find(|(_, n)| n == victim)
         .unwrap_or_else(|| panic!("{victim} not in {kids:?}"));
     let kept = samples(&out);
-    let hit = Instant::now();
-    let sent = Command::new("kill").args([signal, &pid.to_string()]).status().unwrap();
-    assert!(sent.success());
-    let status = wait_exit(&mut run.0, hit + LIMIT, &format!("cosim after {signal} to {victim}"));
-    let took = hit.elapsed();
-    let stderr = std::fs::read_to_string(&stderr_path).unwrap();
-    eprintln!(
-        "{name}: cosim exited {took:.2?} after {signal} to {victim}: {}",
-        stderr.trim()
-    );
-    assert_eq!(status.code(), Some(1), "{stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
-    for word in expect {
-        assert!(lines[0].contains(word), "{word:?} not in {stderr}");
-    }
+    eprintln!("{name}: {signal} to {victim}");
+    let (took, _) = signal_and_expect(&mut run, *pid, signal, &stderr_path, expect);
     // The broker's step timeout is 2 s and its liveliness check is immediate: seconds, not minutes.
     assert!(took < Duration::from_secs(30), "{took:?}");
     let summary = json(&out.join("summary.json"));
@@ -157,20 +168,15 @@ fn interrupted() {
             _dir,
         } = start_with(&name, mode == "in-process");
         let kept = samples(&out);
-        let hit = Instant::now();
-        let sent = Command::new("kill")
-            .args(["-INT", &run.0.id().to_string()])
-            .status()
-            .unwrap();
-        assert!(sent.success());
-        let status = wait_exit(&mut run.0, hit + LIMIT, &format!("cosim {mode} after SIGINT"));
-        let took = hit.elapsed();
-        let stderr = std::fs::read_to_string(&stderr_path).unwrap();
-        eprintln!("{name}: cosim exited {took:.2?} after SIGINT: {}", stderr.trim());
-        assert_eq!(status.code(), Some(1), "{stderr}");
-        let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-        assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
-        assert!(lines[0].contains("interrupted (SIGINT or SIGTERM)"), "{stderr}");
+        eprintln!("{name}: SIGINT");
+        let pid = run.0.id();
+        let (took, _) = signal_and_expect(
+            &mut run,
+            pid,
+            "-INT",
+            &stderr_path,
+            &["interrupted (SIGINT or SIGTERM)"],
+        );
         assert!(took < Duration::from_secs(10), "{took:?}");
         let summary = json(&out.join("summary.json"));
         assert_eq!(summary["status"], "failed", "{summary}");
@@ -204,25 +210,12 @@ fn interrupted_during_a_long_step() {
     } = start_run("interrupted_long_step", "scenes/csm3.toml", &sets, false, 2, 1);
     // Well into coupling step 1.
     std::thread::sleep(Duration::from_secs(1));
-    let hit = Instant::now();
-    let sent = Command::new("kill")
-        .args(["-INT", &run.0.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
-    let status = wait_exit(&mut run.0, hit + LIMIT, "cosim after SIGINT");
-    let took = hit.elapsed();
-    let stderr = std::fs::read_to_string(&stderr_path).unwrap();
-    eprintln!("cosim exited {took:.2?} after SIGINT: {}", stderr.trim());
-    assert_eq!(status.code(), Some(1), "{stderr}");
-    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "one line on stderr: {stderr}");
-    for word in [
+    let words = [
         "fem-node: still computing coupling step 1",
         "interrupted (SIGINT or SIGTERM)",
-    ] {
-        assert!(lines[0].contains(word), "{word:?} not in {stderr}");
-    }
+    ];
+    let pid = run.0.id();
+    signal_and_expect(&mut run, pid, "-INT", &stderr_path, &words);
     let summary = json(&out.join("summary.json"));
     assert_eq!(summary["status"], "failed", "{summary}");
     assert!(
