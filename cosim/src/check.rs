@@ -56,8 +56,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     }
     let samples = s.run.sample_count();
     let frames = s.run.frame_count();
-    // What the run writes into its output folder (no checkpoints: `run --checkpoint-interval` adds them).
-    let disk = DiskEstimate::of(s, &sizing, None, 0.0);
+    // What the run writes into its output folder, with the checkpoints of `--checkpoint-interval` if given.
+    contact_broker::checkpoint::check_interval(args.checkpoint_interval)?;
+    let disk = DiskEstimate::of(s, &sizing, args.checkpoint_interval, 0.0);
     // The run's work from the same estimates: what its time grows with (a mesh of 1e5 thin cells was "valid" at
     // 3e14 element-steps, a year on one core, and nothing said so).
     let fluid_steps = fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil());
@@ -106,6 +107,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
                 "output_bytes": disk.total() as u64,
                 "frame_bytes": disk.frame_bytes as u64,
                 "checkpoint_bytes": disk.checkpoint_bytes as u64,
+                "checkpoints": disk.checkpoints as u64,
             },
             // The corrections in force (§4.4), the per-solver defaults filled in.
             "corrections": s.fluid.as_ref().map(|f| serde_json::json!({

@@ -184,6 +184,9 @@ pub struct CheckArgs {
     /// Print one JSON document instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Count the checkpoints `cosim run --checkpoint-interval SECONDS` would write in the disk estimate.
+    #[arg(long, value_name = "SECONDS")]
+    pub checkpoint_interval: Option<f64>,
 }
 
 /// `cosim compare`.

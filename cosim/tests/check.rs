@@ -21,6 +21,30 @@ fn check_prints_what_would_run() {
     assert!(doc["fem_dt_stable"].as_f64().unwrap() > 0.0);
 }
 
+/// `cosim check` estimates what the run writes into its output folder (`proto::scene::disk`; held to what runs
+/// write by `output_size.rs`), with the checkpoints of `--checkpoint-interval` when given: csm3's 1,001 frames of
+/// 66.6 KiB, and one checkpoint every 2.5 s of its 10 s (4), or one a coupling step for an interval below it.
+#[test]
+fn check_estimates_the_outputs_with_their_checkpoints() {
+    let csm3 = root().join("scenes/csm3.toml");
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", csm3.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let out = cosim_run(&args, Duration::from_secs(30));
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let text = check(&[]);
+    assert!(
+        text.contains("  disk: about 65.2 MiB written to the output folder (1001 frames of 66.6 KiB"),
+        "{text}"
+    );
+    let doc: serde_json::Value = serde_json::from_str(&check(&["--json", "--checkpoint-interval", "2.5"])).unwrap();
+    assert_eq!(doc["estimate"]["checkpoints"], 4, "{doc}");
+    let every_step = check(&["--checkpoint-interval=1e-300"]);
+    assert!(every_step.contains("; 5000 checkpoints of "), "{every_step}");
+}
+
 /// `cosim check SCENE --json --set …` from the workspace root, its document (fails the test unless it succeeds).
 fn check_json(scene: &str, sets: &[&str]) -> serde_json::Value {
     let path = root().join(scene);

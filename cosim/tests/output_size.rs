@@ -1,7 +1,7 @@
 //! What a run writes into its output folder against what `cosim check` estimated (`proto::scene::disk`, which
 //! `cosim run` compares with the free space of the folder's disk): the frames within 2 % (they are counted from the
 //! frame writer's arrays), the checkpoints within 10 % (from what each node saves, measured), on the shipped gate
-//! coupled to WCSPH and to ISPH and on the structure alone. Found 2026-12-06: `--checkpoint-interval=1e-300` wrote a
+//! coupled to WCSPH and to ISPH and on the structure alone (csm3 to its end, 1,001 probe rows). Found 2026-12-06: `--checkpoint-interval=1e-300` wrote a
 //! checkpoint every step (5,000 on csm3, 216 MB) and `run.output_interval = 1e-7` asked the gate for 4 TB of
 //! frames, with nothing to say so before the disk filled.
 
@@ -88,5 +88,6 @@ fn the_outputs_of_the_gate_and_of_a_structure_alone_are_what_check_estimates() {
     compare("gate-wcsph", "scenes/elastic_gate.toml", &short, 0.01);
     let isph = [short[0], short[1], "fluid.solver=\"isph\""];
     compare("gate-isph", "scenes/elastic_gate.toml", &isph, 0.01);
-    compare("csm3", "scenes/csm3.toml", &["run.end_time=1.0"], 0.25);
+    // The whole run: the broker's checkpoints grow with the probe table (1,001 rows at the end).
+    compare("csm3", "scenes/csm3.toml", &[], 2.5);
 }

@@ -101,24 +101,27 @@ impl DiskEstimate {
             && !scene.solids.is_empty()
             && scene.contact.algorithm == ContactAlgorithm::ParticleElement;
         let per_particle = CHECKPOINT_PARTICLE + if isph_contact { CHECKPOINT_ISPH_CONTACT } else { 0.0 };
-        // The broker's checkpoint also holds the probe table so far: half of it on average over the run.
-        let checkpoint_bytes = nf * (per_particle + CHECKPOINT_BROKER_PARTICLE)
-            + nw * CHECKPOINT_WALL
-            + sizing.fem_nodes
-                * (CHECKPOINT_NODE
-                    + if scene.fluid.is_some() {
-                        CHECKPOINT_BROKER_NODE
-                    } else {
-                        0.0
-                    })
-            + 0.5 * samples * values * 8.0
-            + CHECKPOINT_FIXED;
+        let broker_node = match scene.fluid.is_some() {
+            true => CHECKPOINT_BROKER_NODE,
+            false => 0.0,
+        };
         // One at every whole multiple of the interval and one at the end, at most one a coupling step (a run
         // takes at least end_time / max_dt of them).
         let checkpoints = checkpoint_interval.map_or(0.0, |i| {
             let steps = ((run.end_time - from).max(0.0) / scene.coupling.max_dt).ceil();
             ((run.end_time - from).max(0.0) / i).ceil().min(steps)
         });
+        // The broker's checkpoint also holds the probe table so far (8 B a value and 8 a row): at n checkpoints
+        // evenly spread, (n + 1) / 2n of the whole table on average.
+        let table_share = match checkpoints > 0.0 {
+            true => (checkpoints + 1.0) / (2.0 * checkpoints),
+            false => 0.5,
+        };
+        let checkpoint_bytes = nf * (per_particle + CHECKPOINT_BROKER_PARTICLE)
+            + nw * CHECKPOINT_WALL
+            + sizing.fem_nodes * (CHECKPOINT_NODE + broker_node)
+            + table_share * samples * (values + 1.0) * 8.0
+            + CHECKPOINT_FIXED;
         DiskEstimate {
             frames,
             frame_bytes: particle_frame + structure_frame,
