@@ -85,8 +85,12 @@ fn main() {
     cosim_bus::log::init();
     if let Err(e) = run(Args::parse()) {
         cosim_bus::log::say(&format!("contact-broker: {}", format!("{e:#}").replace('\n', " ")));
-        // A run id that is live already and a scene refused are bad input (exit 2, as `cosim run` gives for it).
-        let bad_input = cosim_bus::claim::is_refusal(&e) || e.chain().any(|c| c.is::<cosim_proto::scene::SceneError>());
+        // A run id that is live already, a scene refused and an output folder of someone's own files are bad input
+        // (exit 2, as `cosim run` gives for them).
+        let bad_input = cosim_bus::claim::is_refusal(&e)
+            || e.chain().any(|c| c.is::<cosim_proto::scene::SceneError>())
+            || e.chain()
+                .any(|c| c.is::<contact_broker::output::folder::ForeignFolder>());
         std::process::exit(if bad_input { 2 } else { 1 });
     }
 }
@@ -111,6 +115,8 @@ fn run(args: Args) -> anyhow::Result<()> {
     if !args.ignore_disk_space {
         setup.refuse_full_disk(&args.out)?;
     }
+    // Not a folder of the user's own files (`cosim run` made it, or an earlier run did).
+    contact_broker::output::folder::refuse_foreign(&args.out, &[])?;
     // From here on a signal stops the run between two steps instead of killing the broker mid-step.
     let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let base = args.zenoh_config.as_deref();

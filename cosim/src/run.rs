@@ -222,7 +222,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
 /// the frames: those before the checkpoint stay (and stay listed in the `.pvd` collections); the later ones are
 /// written again. The logs of the run that stopped, which explain why, move to `logs.before-restart`.
 fn prepare_out(out: &Path, scene: &LoadedScene, info: &RunInfo, keep_frames: bool) -> anyhow::Result<()> {
-    refuse_foreign_folder(out)?;
+    // What `cosim bench` writes into a case's folder before the case's run starts.
+    let bench = [crate::bench::runner::LOG_FILE, crate::bench::runner::STATS_FILE];
+    contact_broker::output::folder::refuse_foreign(out, &bench)?;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
     if keep_frames {
         let (logs, kept) = (out.join("logs"), out.join("logs.before-restart"));
@@ -250,46 +252,6 @@ fn prepare_out(out: &Path, scene: &LoadedScene, info: &RunInfo, keep_frames: boo
     std::fs::write(out.join("scene.toml"), scene.scene.to_toml())
         .with_context(|| format!("cannot write {}", out.join("scene.toml").display()))?;
     Ok(())
-}
-
-/// Refuse an output folder that holds anything but an earlier run's outputs: a run clears `frames/`, `plots/` and
-/// `logs/` of its folder, so `--out` pointed at a project folder would delete the user's own (found 2026-12-06:
-/// `--out /tmp/proj` removed `proj/logs/notes.txt`; `--out /` wrote into the root). A folder that does not exist,
-/// is empty (but for a bench case's log), or holds a run's `summary.json` (every run writes one first) is taken.
-fn refuse_foreign_folder(out: &Path) -> anyhow::Result<()> {
-    let Ok(entries) = std::fs::read_dir(out) else {
-        return Ok(());
-    };
-    // What `cosim bench` writes into a case's folder before the case's run starts.
-    let bench = [crate::bench::runner::LOG_FILE, crate::bench::runner::STATS_FILE];
-    let mut names: Vec<String> = entries
-        .filter_map(Result::ok)
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| !bench.contains(&n.as_str()))
-        .collect();
-    names.sort();
-    if names.is_empty() || is_run_summary(&out.join("summary.json")) {
-        return Ok(());
-    }
-    let mut shown: Vec<String> = names.iter().take(3).map(|n| format!("`{n}`")).collect();
-    if names.len() > 3 {
-        shown.push(format!("{} more", names.len() - 3));
-    }
-    anyhow::bail!(
-        "--out {}: the folder holds {} and no summary.json of a run; a run clears frames/, plots/ and logs/ of its \
-         folder, so it writes only into a new or empty folder, or an earlier run's",
-        out.display(),
-        shown.join(", ")
-    )
-}
-
-/// Whether `path` is a run's `summary.json` (a JSON object with its `run_id` and `status`).
-fn is_run_summary(path: &Path) -> bool {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return false;
-    };
-    serde_json::from_str::<serde_json::Value>(&text)
-        .is_ok_and(|v| v.get("run_id").is_some_and(|r| r.is_string()) && v.get("status").is_some())
 }
 
 /// The run in this process: the solver cores (restored from the checkpoint, if any) driven by the coordinator.

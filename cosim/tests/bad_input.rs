@@ -376,7 +376,7 @@ fn external_node_refused_where_it_cannot_join_and_a_missing_one_fails_within_sec
 
 /// An output folder that holds the user's own files is never cleared: a run clears `frames/`, `plots/` and `logs/`
 /// of its folder, so `--out` at a project folder is refused (exit 2, one line naming the folder and what it holds),
-/// and everything in it stays. An earlier run's folder (it has the run's `summary.json`) and an empty one are taken.
+/// by `cosim run` and by the broker started by hand, and everything in it stays. An earlier run's folder (it has the run's `summary.json`) and an empty one are taken.
 /// Found 2026-12-06: `--out /tmp/proj` deleted `proj/logs/notes.txt`, and `--out /` wrote into the root.
 #[test]
 fn a_folder_of_the_users_is_never_cleared() {
@@ -411,6 +411,19 @@ fn a_folder_of_the_users_is_never_cleared() {
             project.display()
         )),
         "{stderr}"
+    );
+    // The broker started by hand (a run over several hosts) refuses it the same way.
+    let mut broker = Command::new(program("contact-broker"));
+    broker
+        .current_dir(root())
+        .args(["--run", &run_id("foreign-out"), "--scene", "scenes/csm3.toml", "--out"])
+        .arg(&project);
+    let out = run_bounded(&mut broker, LIMIT);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("the folder holds `logs`, `plots` and no summary.json"),
+        "{said}"
     );
     assert_eq!(std::fs::read_to_string(project.join("logs/notes.txt")).unwrap(), "mine");
     assert_eq!(

@@ -11,6 +11,7 @@
 mod compare;
 mod csv;
 mod fields;
+pub mod folder;
 mod frames;
 mod plot;
 mod pvd;
