@@ -136,6 +136,10 @@ pub struct RunArgs {
     /// away as they come. Without it such a run is refused (exit 2) rather than failed when the disk is full.
     #[arg(long)]
     pub ignore_disk_space: bool,
+    /// Files a launcher put into the output folder before the run (`cosim bench`'s case log): not the user's own,
+    /// so the folder is still taken (`contact_broker::output::folder`). Not a command-line option.
+    #[arg(skip)]
+    pub beside: Vec<String>,
     /// Keep every message of the run (setup, commands, states, with their envelopes) in `DIR/trace/`, for
     /// `cosim replay` (format: `docs/PROTOCOL.md` §10).
     #[arg(long)]

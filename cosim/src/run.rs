@@ -117,7 +117,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
     if let (Some(connect), false) = (&args.connect, args.in_process) {
         launch::ensure_run_id_free(connect, args.zenoh_config.as_deref(), &info.run_id)?;
     }
-    prepare_out(&out, scene, &info, own_folder)?;
+    prepare_out(&out, scene, &info, own_folder, &args.beside)?;
     // Not refused: a mesh that fine for this fluid runs, but its energy is not to be trusted (mass_ratio.rs).
     // The fluid's first stable step estimated from the scene (WCSPH at rest): how many of them a contact pass spans.
     let s = &scene.scene;
@@ -221,10 +221,15 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
 /// and keep the resolved scene beside them. A restart into the folder of the run it continues (`keep_frames`) keeps
 /// the frames: those before the checkpoint stay (and stay listed in the `.pvd` collections); the later ones are
 /// written again. The logs of the run that stopped, which explain why, move to `logs.before-restart`.
-fn prepare_out(out: &Path, scene: &LoadedScene, info: &RunInfo, keep_frames: bool) -> anyhow::Result<()> {
-    // What `cosim bench` writes into a case's folder before the case's run starts.
-    let bench = [crate::bench::runner::LOG_FILE, crate::bench::runner::STATS_FILE];
-    contact_broker::output::folder::refuse_foreign(out, &bench)?;
+fn prepare_out(
+    out: &Path,
+    scene: &LoadedScene,
+    info: &RunInfo,
+    keep_frames: bool,
+    beside: &[String],
+) -> anyhow::Result<()> {
+    let beside: Vec<&str> = beside.iter().map(String::as_str).collect();
+    contact_broker::output::folder::refuse_foreign(out, &beside)?;
     std::fs::create_dir_all(out).with_context(|| format!("cannot create the output folder {}", out.display()))?;
     if keep_frames {
         let (logs, kept) = (out.join("logs"), out.join("logs.before-restart"));

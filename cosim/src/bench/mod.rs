@@ -160,7 +160,12 @@ fn command_line() -> String {
 /// memory and CPU time written to `--stats-out` as JSON.
 pub fn bench_run(args: &BenchRunArgs) -> anyhow::Result<ExitCode> {
     follow_the_bench()?;
-    let code = crate::run::run(&args.run)?;
+    // The case's log and statistics are the bench's, beside the run's outputs in its folder.
+    let run = crate::cli::RunArgs {
+        beside: vec![runner::LOG_FILE.into(), runner::STATS_FILE.into()],
+        ..args.run.clone()
+    };
+    let code = crate::run::run(&run)?;
     let stats = serde_json::to_string(&runner::ProcessStats::of_this_process())?;
     let path = &args.stats_out;
     std::fs::write(path, stats + "\n").with_context(|| format!("cannot write {}", path.display()))?;
