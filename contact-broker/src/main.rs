@@ -88,9 +88,9 @@ fn main() {
         // A run id that is live already, a scene refused and an output folder of someone's own files are bad input
         // (exit 2, as `cosim run` gives for them).
         let bad_input = cosim_bus::claim::is_refusal(&e)
-            || e.chain().any(|c| c.is::<cosim_proto::scene::SceneError>())
-            || e.chain()
-                .any(|c| c.is::<contact_broker::output::folder::ForeignFolder>());
+            || e.chain().any(|c| {
+                c.is::<cosim_proto::scene::SceneError>() || c.is::<contact_broker::output::folder::ForeignFolder>()
+            });
         std::process::exit(if bad_input { 2 } else { 1 });
     }
 }

@@ -8,7 +8,8 @@
 //! within one coupling step.
 
 use cosim_proto::scene::Scene;
-use cosim_proto::sizing::{count, number};
+use cosim_proto::sizing::count;
+use cosim_proto::Num;
 
 /// The most steps of one kind a run may need: at 1 µs a step, 12 days.
 pub const MAX_STEPS: f64 = 1e12;
@@ -24,8 +25,8 @@ pub fn refuse_endless(scene: &Scene) -> Result<(), (String, String)> {
             format!(
                 "{} s: the {} s of run.end_time take at least {} coupling steps, more than the {MAX_STEPS:e} a run \
                  may take",
-                number(scene.coupling.max_dt),
-                number(end),
+                Num(scene.coupling.max_dt),
+                Num(end),
                 count(coupling)
             ),
         ));
@@ -39,11 +40,11 @@ pub fn refuse_endless(scene: &Scene) -> Result<(), (String, String)> {
     let steps = end / dt;
     if too_many(steps) {
         let (value, condition) = match key {
-            "fluid.kinematic_viscosity" => (format!("{} m²/s", number(fluid.kinematic_viscosity)), "0.125 h²/ν"),
+            "fluid.kinematic_viscosity" => (format!("{} m²/s", Num(fluid.kinematic_viscosity)), "0.125 h²/ν"),
             _ => (
                 fluid
                     .sound_speed
-                    .map_or("its default".into(), |c| format!("{} m/s", number(c))),
+                    .map_or("its default".into(), |c| format!("{} m/s", Num(c))),
                 "0.25 h/c0",
             ),
         };
@@ -53,7 +54,7 @@ pub fn refuse_endless(scene: &Scene) -> Result<(), (String, String)> {
                 "{value} holds the fluid's step to at most {dt:.3e} s ({condition}, h = {:.3e} m): the {} s of \
                  run.end_time take at least {} fluid steps, more than the {MAX_STEPS:e} a run may take",
                 fluid.smoothing_ratio * fluid.spacing,
-                number(end),
+                Num(end),
                 count(steps)
             ),
         ));

@@ -145,8 +145,7 @@ fn retry_ports(
             Err(e) => last = Some(e),
         }
         // A fixed port that failed fails the same way again; a picked one is tried again only if it was taken.
-        let picked = endpoints.iter().zip(listen).filter(|(e, l)| e != l);
-        if !picked.into_iter().any(|(e, _)| taken(e)) {
+        if !endpoints.iter().zip(listen).any(|(e, l)| e != l && taken(e)) {
             break;
         }
     }

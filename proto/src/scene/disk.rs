@@ -6,10 +6,10 @@
 //! Frames are counted from what the frame writer puts in them (`contact-broker/src/output/vtu.rs`: every array in
 //! base64, 4 characters for 3 bytes), so their estimate is good to the XML around the arrays (~1.5 KB a frame).
 //! Checkpoints are counted from what each node saves, per particle and node, measured on the shipped scenes
-//! (2026-12-06; docs/PERFORMANCE.md "Output size"); `cosim_bus::disk` tests both against a run's folder.
+//! (2026-12-06; docs/PERFORMANCE.md "Output size"); `cosim/tests/output_size.rs` holds both to what runs write.
 
 use super::schema::{ContactAlgorithm, ElementKind, FluidSolver, Scene};
-use super::sizing::{bytes_text, count, Sizing};
+use super::sizing::{bytes_text, count, solid_counts, Sizing};
 use crate::Num;
 
 /// Per particle of a particle frame: position (3 × f64), velocity (3 × f64), pressure, density, wall flag
@@ -68,24 +68,26 @@ impl DiskEstimate {
     /// with a checkpoint every `checkpoint_interval` seconds of simulated time.
     pub fn of(scene: &Scene, sizing: &Sizing, checkpoint_interval: Option<f64>, from: f64) -> Self {
         let run = &scene.run;
-        let left = (run.end_time - from).max(0.0) / run.end_time;
+        let remaining = (run.end_time - from).max(0.0);
+        let left = remaining / run.end_time;
+        let beside_fluid = scene.fluid.is_some();
         let (nf, nw) = (sizing.fluid_particles, sizing.wall_particles);
         let base64 = |raw: f64| 4.0 * (raw / 3.0).ceil();
         let particle_frame = match scene.fluid.is_some() {
             true => base64(PARTICLE_POINT * (nf + nw)) + FRAME_XML,
             false => 0.0,
         };
-        let per_node = STRUCTURE_NODE + if scene.fluid.is_some() { STRUCTURE_LOAD } else { 0.0 };
+        let per_node = STRUCTURE_NODE + if beside_fluid { STRUCTURE_LOAD } else { 0.0 };
         let structure_raw: f64 = scene
             .solids
             .iter()
             .map(|solid| {
-                let [dx, dy] = solid.divisions.map(f64::from);
-                let (cells, corners) = match solid.element {
-                    ElementKind::Quad4 => (dx * dy, 4.0),
-                    ElementKind::Tri3 => (2.0 * dx * dy, 3.0),
+                let (nodes, elements) = solid_counts(solid);
+                let corners = match solid.element {
+                    ElementKind::Quad4 => 4.0,
+                    ElementKind::Tri3 => 3.0,
                 };
-                (dx + 1.0) * (dy + 1.0) * per_node + cells * (STRUCTURE_CELL + 8.0 * corners)
+                nodes * per_node + elements * (STRUCTURE_CELL + 8.0 * corners)
             })
             .sum();
         let structure_frame = match scene.solids.is_empty() {
@@ -101,15 +103,11 @@ impl DiskEstimate {
             && !scene.solids.is_empty()
             && scene.contact.algorithm == ContactAlgorithm::ParticleElement;
         let per_particle = CHECKPOINT_PARTICLE + if isph_contact { CHECKPOINT_ISPH_CONTACT } else { 0.0 };
-        let broker_node = match scene.fluid.is_some() {
-            true => CHECKPOINT_BROKER_NODE,
-            false => 0.0,
-        };
+        let broker_node = if beside_fluid { CHECKPOINT_BROKER_NODE } else { 0.0 };
         // One at every whole multiple of the interval and one at the end, at most one a coupling step (a run
         // takes at least end_time / max_dt of them).
         let checkpoints = checkpoint_interval.map_or(0.0, |i| {
-            let steps = ((run.end_time - from).max(0.0) / scene.coupling.max_dt).ceil();
-            ((run.end_time - from).max(0.0) / i).ceil().min(steps)
+            (remaining / i).ceil().min((remaining / scene.coupling.max_dt).ceil())
         });
         // The broker's checkpoint also holds the probe table so far (8 B a value and 8 a row): at n checkpoints
         // evenly spread, (n + 1) / 2n of the whole table on average.

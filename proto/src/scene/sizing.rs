@@ -383,7 +383,7 @@ fn wall_particles(wall: &BoxSpec, origin: [f64; 2], dx: f64, h: f64) -> f64 {
 }
 
 /// FE nodes and elements of one solid.
-fn solid_counts(solid: &SolidSpec) -> (f64, f64) {
+pub(super) fn solid_counts(solid: &SolidSpec) -> (f64, f64) {
     let [dx, dy] = solid.divisions.map(f64::from);
     let cells = dx * dy;
     let elements = match solid.element {
@@ -465,11 +465,6 @@ pub fn count(n: f64) -> String {
     } else {
         format!("{n:.2e}")
     }
-}
-
-/// A value as it reads best in a message ([`crate::Num`]): a `coupling.max_dt` of 1e-300 is not 300 zeros.
-pub fn number(x: f64) -> String {
-    crate::Num(x).to_string()
 }
 
 /// Bytes in binary units (KiB, MiB, GiB, TiB, …).
