@@ -101,17 +101,29 @@ impl CellGrid {
     /// The items whose boxes overlap the cell holding `p` (empty outside the grid or for a non-finite `p`).
     #[inline]
     pub fn query(&self, p: Vec2) -> &[u32] {
+        &self.items[self.query_range(p)]
+    }
+
+    /// Where [`CellGrid::query`]'s items lie in [`CellGrid::items`], so that a table in the same order (one entry
+    /// an item of a cell) can be read alongside.
+    #[inline]
+    pub fn query_range(&self, p: Vec2) -> std::ops::Range<usize> {
         if self.nx == 0 {
-            return &[];
+            return 0..0;
         }
         let fx = (p[0] - self.origin[0]) / self.cell;
         let fy = (p[1] - self.origin[1]) / self.cell;
         // Written so that NaN fails the test.
         if !(fx >= 0.0 && fy >= 0.0 && fx < self.nx as f64 && fy < self.ny as f64) {
-            return &[];
+            return 0..0;
         }
         let c = fy as usize * self.nx + fx as usize;
-        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+        self.start[c] as usize..self.start[c + 1] as usize
+    }
+
+    /// Every cell's items, cell after cell (what [`CellGrid::query_range`] indexes).
+    pub fn items(&self) -> &[u32] {
+        &self.items
     }
 }
 

@@ -25,11 +25,15 @@ pub(super) struct Mark {
 }
 
 /// What a pass computes once when its nodes are static (`Setup::nodes_static`) instead of at each detection: the
-/// frame of every segment, and which nodes may act as masters at all (`Detector::node_may_act`). Scratch.
+/// frame of every segment, which nodes may act as masters at all (`Detector::node_may_act`), and each grid item's
+/// segment box. Scratch.
 #[derive(Clone, Debug, Default)]
 pub(super) struct StaticGeometry {
     frames: Vec<Option<Frame>>,
     node_acts: Vec<bool>,
+    /// The box of the segment of each entry of the grid's items, in their order (cell after cell), not inflated:
+    /// [x min, x max, y min, y max], so a gather reads its cell's boxes in one run instead of each segment's nodes.
+    boxes: Vec<[f64; 4]>,
 }
 
 /// The context of one pass, fixed for its whole length (node positions are not in it: they change in the position
@@ -133,6 +137,12 @@ impl<'a> Setup<'a> {
             det.frames_into(&mut statics.frames);
             statics.node_acts.clear();
             statics.node_acts.extend((0..nn).map(|k| det.node_may_act(k)));
+            statics.boxes.clear();
+            statics.boxes.extend(grid.items().iter().map(|&j| {
+                let s = segments[j as usize];
+                let (a, b) = (nodes.x[s.a], nodes.x[s.b]);
+                [a[0].min(b[0]), a[0].max(b[0]), a[1].min(b[1]), a[1].max(b[1])]
+            }));
             &*statics
         });
         Setup {
@@ -185,14 +195,31 @@ impl<'a> Setup<'a> {
 
     fn gather_within(&self, x: &[Vec2], xs: Vec2, inflate: f64, out: &mut Vec<Master>) {
         out.clear();
-        // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out changes nothing.
-        let acts = self.statics.map(|g| &g.node_acts[..]);
+        if let Some(g) = self.statics {
+            // Static nodes: the boxes of the grid's build, read in the cell's order; the same comparisons of the
+            // same numbers as below, so the same masters.
+            let range = self.grid.query_range(xs);
+            let (items, boxes) = (&self.grid.items()[range.clone()], &g.boxes[range]);
+            for (&j, bx) in items.iter().zip(boxes) {
+                let outside = xs[0] < bx[0] - inflate
+                    || xs[0] > bx[1] + inflate
+                    || xs[1] < bx[2] - inflate
+                    || xs[1] > bx[3] + inflate;
+                if !outside {
+                    let s = self.segments[j as usize];
+                    // A node that acts nowhere (concave or straight corner) finds no contact: leaving it out
+                    // changes nothing.
+                    self.topo.masters_near(j as usize, s, Some(&g.node_acts), out);
+                }
+            }
+            return;
+        }
         for &j in self.grid.query(xs) {
             let s = self.segments[j as usize];
             let (a, b) = (x[s.a], x[s.b]);
             let outside = |k: usize| xs[k] < a[k].min(b[k]) - inflate || xs[k] > a[k].max(b[k]) + inflate;
             if !(outside(0) || outside(1)) {
-                self.topo.masters_near(j as usize, s, acts, out);
+                self.topo.masters_near(j as usize, s, None, out);
             }
         }
     }
