@@ -4,13 +4,26 @@
 
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+use std::time::{Duration, Instant};
 
 use signal_hook::consts::{SIGINT, SIGTERM};
 
+/// How long a coupling step still in progress when a signal arrives is given to end on its own (the run then stops
+/// between two steps, as for any signal): after that the step is given up, the node's answer no longer awaited
+/// (processes) or its sub-cycle left (in this process), and the run ends `failed` with its outputs so far. Well
+/// within the 10 s `cosim run` gives the broker to stop before it kills it.
+pub const STOP_WAIT: Duration = Duration::from_secs(2);
+
 /// Set once SIGINT or SIGTERM arrived (after [`Interrupt::install`]).
 #[derive(Clone, Debug)]
-pub struct Interrupt(Arc<AtomicBool>);
+pub struct Interrupt {
+    flag: Arc<AtomicBool>,
+    /// When [`Interrupt::overdue`] first saw the signal.
+    seen: Arc<OnceLock<Instant>>,
+    /// How long after that it answers true ([`STOP_WAIT`]).
+    wait: Duration,
+}
 
 impl Interrupt {
     /// Catch SIGINT and SIGTERM for the rest of the process's life.
@@ -21,12 +34,32 @@ impl Interrupt {
             signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&flag))?;
             signal_hook::flag::register(signal, Arc::clone(&flag))?;
         }
-        Ok(Self(flag))
+        Ok(Self::from_flag(flag))
+    }
+
+    /// An interrupt that `flag` raises (a test's, or one set by other means than a signal).
+    pub fn from_flag(flag: Arc<AtomicBool>) -> Self {
+        Self {
+            flag,
+            seen: Arc::default(),
+            wait: STOP_WAIT,
+        }
+    }
+
+    /// This interrupt with [`Interrupt::overdue`] answering `wait` after the signal instead of [`STOP_WAIT`].
+    pub fn with_wait(self, wait: Duration) -> Self {
+        Self { wait, ..self }
     }
 
     /// Whether a signal arrived.
     pub fn arrived(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
+        self.flag.load(Ordering::Relaxed)
+    }
+
+    /// Whether a computation in progress should be given up: the signal arrived [`STOP_WAIT`] ago or more (as
+    /// first seen here; a caller asks often, between two sub-steps).
+    pub fn overdue(&self) -> bool {
+        self.arrived() && self.seen.get_or_init(Instant::now).elapsed() >= self.wait
     }
 
     /// What a run's progress callback answers (`contact_broker::coordinator::Control`): stop with [`REASON`]
@@ -41,3 +74,26 @@ impl Interrupt {
 
 /// The reason a run stopped by a signal gives (summary.json's `message` ends with it).
 pub const REASON: &str = "interrupted (SIGINT or SIGTERM)";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Overdue only once the signal arrived and its wait passed since it was first seen; clones share that moment.
+    #[test]
+    fn overdue_after_the_wait_from_when_the_signal_was_first_seen() {
+        let flag = Arc::new(AtomicBool::new(false));
+        let interrupt = Interrupt::from_flag(Arc::clone(&flag)).with_wait(Duration::from_millis(200));
+        let clone = interrupt.clone();
+        assert!(!interrupt.overdue() && !interrupt.arrived());
+        flag.store(true, Ordering::Relaxed);
+        let seen = Instant::now();
+        assert!(interrupt.arrived() && !interrupt.overdue(), "not before its wait");
+        while seen.elapsed() < Duration::from_millis(200) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        assert!(clone.overdue(), "the clone counts from the first sight");
+        assert!(Interrupt::from_flag(flag).with_wait(Duration::ZERO).overdue());
+        assert_eq!(Interrupt::from_flag(Arc::default()).wait, STOP_WAIT);
+    }
+}

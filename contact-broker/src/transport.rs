@@ -19,7 +19,7 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
-use cosim_bus::interrupt::{Interrupt, REASON};
+use cosim_bus::interrupt::{Interrupt, REASON, STOP_WAIT};
 use cosim_bus::link_loss;
 use cosim_proto::trace::Kind;
 
@@ -289,10 +289,6 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
 /// answers it from its zenoh threads whatever it is computing, within milliseconds; one that is gone (a failed run)
 /// costs the whole wait.
 const COUNTS_TIMEOUT: Duration = Duration::from_millis(500);
-
-/// How long a wait for a node's answer goes on after Ctrl-C or SIGTERM ([`ZenohLink::stop_on`]): well within the
-/// 10 s `cosim run` gives the broker to stop before it kills it.
-const STOP_WAIT: Duration = Duration::from_secs(2);
 
 impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S, T> {
     type Setup = S;

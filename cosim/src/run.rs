@@ -270,9 +270,13 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         true => Some(Recorder::begin(&info.out, &info.run_id, setup)?),
         false => None,
     };
+    // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once); a step still
+    // in progress 2 s after it is given up between two of its sub-steps.
+    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let mut fem = match scene.scene.solids.is_empty() {
         false => {
             let mut core = FemCore::new(&scene.scene).context("fem-node")?;
+            core.stop_on(interrupt.clone());
             if let Some(data) = setup.saved_fem() {
                 core.restore(data)
                     .context("fem-node: cannot restart from the checkpoint")?;
@@ -284,6 +288,7 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
     let mut sph = match scene.scene.fluid {
         Some(_) => {
             let mut core = SphCore::new(&scene.scene).context("sph-node")?;
+            core.stop_on(interrupt.clone());
             if let Some(data) = setup.saved_sph() {
                 core.restore(data)
                     .context("sph-node: cannot restart from the checkpoint")?;
@@ -296,8 +301,6 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         fem: fem.as_deref_mut(),
         sph: sph.as_deref_mut(),
     };
-    // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once).
-    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
     let outcome = setup.run(nodes, info, &mut |p| {
         bar.update(p);
         interrupt.control()

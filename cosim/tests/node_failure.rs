@@ -229,6 +229,33 @@ fn interrupted_during_a_long_step() {
     assert_all_gone(&kids);
 }
 
+/// The same in one process (`--in-process`): the structure's sub-cycle is left between two sub-steps 2 s after the
+/// Ctrl-C (`cosim_bus::interrupt::STOP_WAIT`), and the run ends `failed` with its outputs so far. Before, the run
+/// waited for the coupling step (4.5 minutes here) or died at a second Ctrl-C with none.
+#[test]
+fn interrupted_in_process_during_a_long_step() {
+    let sets = ["solid[0].divisions=[1,30000]"];
+    let Started {
+        mut run,
+        out,
+        stderr_path,
+        _dir,
+        ..
+    } = start_run("interrupted_long_step_ip", "scenes/csm3.toml", &sets, true, 0, 1);
+    std::thread::sleep(Duration::from_secs(1));
+    let words = [
+        "coupling step 1 from t = 0 s: fem-node: stopped after",
+        "interrupted (SIGINT or SIGTERM)",
+    ];
+    let pid = run.0.id();
+    let (took, _) = signal_and_expect(&mut run, pid, "-INT", &stderr_path, &words);
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    assert_eq!(samples(&out), 1);
+    assert!(out.join("plots/tip_ux.svg").is_file(), "no plot written");
+}
+
 /// `cosim run` itself killed with SIGKILL (it runs no clean-up): the broker finds its progress pipe closed, stops
 /// the run within a progress interval and writes why in summary.json; the nodes follow it. Nothing may go on
 /// computing a run nobody collects (before, the broker ran on to the scene's end time).

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use bincode::Options;
 
+use cosim_bus::interrupt::{Interrupt, REASON};
 use cosim_proto::messages::{FemMesh, FemState, StepCommand};
 use cosim_proto::scene::Scene;
 
@@ -23,6 +24,8 @@ pub struct FemCore {
     interface_nodes: Vec<u32>,
     /// `coupling.max_dt`: no command may ask for a longer step.
     max_dt: f64,
+    /// A signal that gives up a step in progress ([`FemCore::stop_on`]).
+    stop: Option<Interrupt>,
 }
 
 impl FemCore {
@@ -37,7 +40,16 @@ impl FemCore {
             mesh,
             interface_nodes,
             max_dt: scene.coupling.max_dt,
+            stop: None,
         })
+    }
+
+    /// Give up a step still in progress [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after `interrupt` arrived, between two sub-steps
+    /// ([`FemError::Stopped`]): in `cosim run --in-process`, a coupling step of minutes (a fine mesh) would hold
+    /// Ctrl-C that long. A step that ends within that time is still taken. (As a process the node need not: the
+    /// broker stops waiting for its answer.)
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.stop = Some(interrupt);
     }
 
     /// The `fem/mesh` registration message.
@@ -99,7 +111,9 @@ impl FemCore {
         // `DEFAULT_PARALLEL_MIN_ELEMENTS`, and a parallel loop started from outside the pool hands its work to a
         // worker and sleeps, two context switches a sub-step; the same bits either way.
         let substeps = if cmd.dt > 0.0 {
-            rayon::scope(|_| self.solver.advance(cmd.dt))?
+            let stop = self.stop.clone();
+            let overdue = move || stop.as_ref().is_some_and(Interrupt::overdue).then_some(REASON);
+            rayon::scope(|_| self.solver.advance_until(cmd.dt, &overdue))?
         } else {
             0
         };

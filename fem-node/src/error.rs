@@ -30,6 +30,19 @@ pub enum FemError {
         /// What went wrong.
         reason: String,
     },
+    /// The caller stopped an [`advance`](crate::solver::FemSolver::advance_until) between two sub-steps; the state
+    /// is part of the way through the step (the run ends here).
+    #[error("stopped after {done} of {of} sub-steps of {dt:e} s: {why}")]
+    Stopped {
+        /// Sub-steps taken.
+        done: u32,
+        /// Sub-steps the step needed.
+        of: u32,
+        /// The step asked for [s].
+        dt: f64,
+        /// The caller's reason.
+        why: &'static str,
+    },
 }
 
 /// `Result` with [`FemError`] by default.

@@ -40,6 +40,37 @@ fn advance_sub_cycles_within_the_stable_step() {
     }
 }
 
+/// `advance_until` asks before each sub-step but the first: stopped at its third question it has taken 3 of the 8
+/// sub-steps, bit for bit those of `advance`; never stopped it is `advance`.
+#[test]
+fn advance_until_stops_between_two_sub_steps() {
+    let (mut whole, mut cut, mut three) = (
+        bar(ElementKind::Quad4),
+        bar(ElementKind::Quad4),
+        bar(ElementKind::Quad4),
+    );
+    let dt = 7.3 * whole.stable_dt();
+    assert_eq!(whole.advance(dt).unwrap(), 8);
+    let asked = std::cell::Cell::new(0);
+    let stop = || {
+        asked.set(asked.get() + 1);
+        (asked.get() == 3).then_some("enough")
+    };
+    match cut.advance_until(dt, &stop) {
+        Err(e @ FemError::Stopped { done: 3, of: 8, .. }) => assert!(e.to_string().ends_with(": enough"), "{e}"),
+        other => panic!("expected Stopped after 3 of 8, got {other:?}"),
+    }
+    for _ in 0..3 {
+        three.substep(dt / 8.0).unwrap();
+    }
+    assert_eq!(cut.state().step, 3);
+    let bits = |s: &fem_node::FemSolver| s.state().x.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&cut), bits(&three));
+    let mut never = bar(ElementKind::Quad4);
+    assert_eq!(never.advance_until(dt, &|| None).unwrap(), 8);
+    assert_eq!(bits(&never), bits(&whole));
+}
+
 #[test]
 fn clamped_nodes_stay_put_and_ignore_corrections() {
     let mut s = bar(ElementKind::Quad4);

@@ -5,6 +5,7 @@
 use std::time::Instant;
 
 use bincode::Options;
+use cosim_bus::interrupt::{Interrupt, REASON};
 use cosim_proto::messages::{ContactFace, Correction, SphSetup, SphSnapshot, SphState, StepCommand};
 use cosim_proto::scene::{FluidSolver as SceneSolver, Scene};
 use serde::{Deserialize, Serialize};
@@ -76,6 +77,8 @@ pub struct SphCore {
     max_dt: f64,
     /// The scene's interval-mean pressure sensors, logged after every step.
     sensors: IntervalSensors,
+    /// A signal that gives up a step in progress ([`SphCore::stop_on`]).
+    stop: Option<Interrupt>,
 }
 
 impl SphCore {
@@ -104,7 +107,16 @@ impl SphCore {
             guard,
             max_dt: scene.coupling.max_dt,
             sensors,
+            stop: None,
         })
+    }
+
+    /// Give up a step still in progress [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after `interrupt` arrived,
+    /// between two sub-steps ([`SphError::Stopped`]): in `cosim run --in-process`, a coupling step of many fluid
+    /// steps would hold Ctrl-C that long. A step that ends within that time is still taken. (As a process the node
+    /// need not: the broker stops waiting for its answer.)
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.stop = Some(interrupt);
     }
 
     /// The `sph/setup` registration message.
@@ -211,6 +223,13 @@ impl SphCore {
         // Sub-cycle at the solver's own adaptive stable step (one step when the broker already capped dt by it).
         let mut done = 0.0;
         while done < dt {
+            if substeps > 0 && self.stop.as_ref().is_some_and(Interrupt::overdue) {
+                return Err(SphError::Stopped {
+                    done: substeps,
+                    dt,
+                    why: REASON,
+                });
+            }
             let (stable, left) = (self.solver.stable_dt(), dt - done);
             let mut h = stable.min(left);
             if self.solver.equal_substeps() && left > stable {

@@ -55,6 +55,17 @@ pub enum SphError {
         /// Relative (Jacobi-preconditioned) residual reached.
         residual: f64,
     },
+    /// The caller stopped the sub-cycle of a coupling step between two of its steps; the state is part of the way
+    /// through the coupling step (the run ends here).
+    #[error("stopped after {done} fluid steps of the coupling step of {dt:e} s: {why}")]
+    Stopped {
+        /// Fluid steps taken.
+        done: u32,
+        /// The coupling step asked for [s].
+        dt: f64,
+        /// The caller's reason.
+        why: &'static str,
+    },
 }
 
 impl SphError {

@@ -59,3 +59,40 @@ fn a_collapsed_step_is_an_error_not_an_endless_subcycle() {
         assert!(err.is_unstable(), "{solver}");
     }
 }
+
+/// A coupling step of many fluid steps, interrupted: the sub-cycle is left between two of its steps once the
+/// interrupt is overdue (`cosim run --in-process` and Ctrl-C), for both solvers; one that never arrives changes
+/// nothing.
+#[test]
+fn an_overdue_interrupt_leaves_the_sub_cycle_between_two_steps() {
+    use cosim_bus::interrupt::Interrupt;
+    use cosim_proto::messages::StepCommand;
+    use sph_node::core::SphCore;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    for solver in ["wcsph", "isph"] {
+        let mut scene = common::still_water(0.2, 0.2, 0.02, &format!("solver = \"{solver}\""));
+        scene.coupling.max_dt = 1.0;
+        let command = |core: &SphCore| StepCommand {
+            dt: 10.5 * core.solver().stable_dt(),
+            corrections: Vec::new(),
+            roi: None,
+            want_interface: false,
+            want_snapshot: false,
+            stop: false,
+        };
+        let mut core = SphCore::new(&scene).expect("core");
+        let signal = Arc::new(AtomicBool::new(true));
+        core.stop_on(Interrupt::from_flag(signal).with_wait(std::time::Duration::ZERO));
+        let err = core.handle(&command(&core)).expect_err("stopped");
+        match &err {
+            SphError::Stopped { done: 1, .. } => assert!(!err.is_unstable(), "{solver}"),
+            other => panic!("{solver}: expected Stopped after 1 step, got {other}"),
+        }
+        assert_eq!(core.solver().state().step, 1, "{solver}");
+        let mut core = SphCore::new(&scene).expect("core");
+        core.stop_on(Interrupt::from_flag(Arc::new(AtomicBool::new(false))).with_wait(std::time::Duration::ZERO));
+        let state = core.handle(&command(&core)).expect("no signal").expect("a state");
+        assert!(state.substeps >= 11, "{solver}: {}", state.substeps);
+    }
+}

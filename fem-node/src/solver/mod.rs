@@ -137,6 +137,13 @@ impl FemSolver {
     /// Advances by `dt` in `k = ceil(dt / Δt_stable)` equal sub-steps (the stable step is recomputed at the start
     /// of each call) and returns `k`; `dt = 0` does nothing.
     pub fn advance(&mut self, dt: f64) -> Result<u32> {
+        self.advance_until(dt, &|| None)
+    }
+
+    /// [`FemSolver::advance`], asking `stop` before each sub-step but the first: a reason from it ends the step
+    /// there with [`FemError::Stopped`] (a step of many sub-steps that the user interrupts). The same bits as
+    /// `advance` while it answers `None`.
+    pub fn advance_until(&mut self, dt: f64, stop: &dyn Fn() -> Option<&'static str>) -> Result<u32> {
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(FemError::InvalidParameter {
                 name: "dt",
@@ -167,7 +174,15 @@ impl FemSolver {
             });
         }
         let (k, h, t0) = (k as u32, dt / k, self.state.t);
-        for _ in 0..k {
+        for i in 0..k {
+            if let Some(why) = (i > 0).then(stop).flatten() {
+                return Err(FemError::Stopped {
+                    done: i,
+                    of: k,
+                    dt,
+                    why,
+                });
+            }
             self.substep(h)?;
         }
         self.state.t = t0 + dt;
