@@ -56,6 +56,13 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
     let base = zenoh_config.as_deref();
     // A bad config file is its own error, not "cannot reach the run".
     base_config(base)?;
+    // Zenoh tries a refused endpoint again until the timeout: a port nothing listens on is said at once.
+    if let Some(addr) = refused(&connect) {
+        anyhow::bail!(
+            "cannot reach run `{id}` at {connect}: nothing listens there ({addr} refused the connection); is the \
+             run's broker (or router) up, and is this the endpoint it printed?"
+        );
+    }
     let session = match client {
         true => open_client_from(base, std::slice::from_ref(&connect), timeout_ms),
         // Listening too: the nodes learn of this process through the broker (gossip) and connect to it, which is
@@ -73,4 +80,50 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
     // Let zenoh learn the run's queryables (gossip) before the first question.
     std::thread::sleep(Duration::from_millis(1500));
     Ok((session, connect))
+}
+
+/// The address of a TCP or TLS endpoint (`tcp/HOST:PORT`, `tls/…`; metadata after `?` or `#` ignored) whose every
+/// resolved address refused a connection: nothing listens there. `None` for any other endpoint or answer (one that
+/// accepts, does not answer within a second, or cannot be resolved here: zenoh says what it finds).
+fn refused(endpoint: &str) -> Option<String> {
+    use std::net::{TcpStream, ToSocketAddrs};
+    let rest = endpoint
+        .strip_prefix("tcp/")
+        .or_else(|| endpoint.strip_prefix("tls/"))?;
+    let address = rest.split(['?', '#']).next()?;
+    let resolved: Vec<_> = address.to_socket_addrs().ok()?.collect();
+    let all_refused = !resolved.is_empty()
+        && resolved.iter().all(|a| {
+            TcpStream::connect_timeout(a, Duration::from_secs(1))
+                .is_err_and(|e| e.kind() == std::io::ErrorKind::ConnectionRefused)
+        });
+    all_refused.then(|| address.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::refused;
+
+    /// A port closed on loopback is refused; one that listens, and endpoints that are not TCP, are not.
+    #[test]
+    fn a_closed_port_is_refused_and_a_listening_one_is_not() {
+        let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let open = listener.local_addr().unwrap().port();
+        let closed = std::net::TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port();
+        assert_eq!(
+            refused(&format!("tcp/127.0.0.1:{closed}")).as_deref(),
+            Some(&*format!("127.0.0.1:{closed}"))
+        );
+        assert_eq!(
+            refused(&format!("tls/127.0.0.1:{closed}#iface=lo")).as_deref(),
+            Some(&*format!("127.0.0.1:{closed}"))
+        );
+        assert_eq!(refused(&format!("tcp/127.0.0.1:{open}")), None);
+        assert_eq!(refused(&format!("unixsock-stream//tmp/nothing-{closed}")), None);
+        assert_eq!(refused("tcp/not an address"), None);
+    }
 }

@@ -321,3 +321,30 @@ fn a_blow_up_pauses_with_the_processes_alive_through_a_router() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--connect` to a port nothing listens on: said at once, exit 2, for `ctl`, `inspect` and `snapshot`. Before,
+/// zenoh tried the refused endpoint again until `--timeout` (here 50 s: the runs would have outlasted
+/// `cosim_run`'s 60 s only just, and said "within 50 s" instead of why).
+#[test]
+fn a_closed_endpoint_is_said_at_once() {
+    let closed = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let endpoint = format!("tcp/127.0.0.1:{closed}");
+    for args in [
+        vec!["ctl", "nowhere", "status"],
+        vec!["inspect", "nowhere", "--once"],
+        vec!["snapshot", "nowhere", "--out", "/tmp/cosim-closed-endpoint-snapshot"],
+    ] {
+        let mut args = args;
+        args.extend(["--connect", &endpoint, "--timeout", "50"]);
+        let (code, _, text) = cosim_json(&args);
+        assert_eq!(code, 2, "{args:?}: {text}");
+        assert!(
+            text.contains(&format!("at {endpoint}: nothing listens there")),
+            "{args:?}: {text}"
+        );
+    }
+}
