@@ -270,33 +270,40 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         true => Some(Recorder::begin(&info.out, &info.run_id, setup)?),
         false => None,
     };
-    // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once); a step still
-    // in progress 2 s after it is given up between two of its sub-steps.
-    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
-    let mut fem = match scene.scene.solids.is_empty() {
+    let fem_core = match scene.scene.solids.is_empty() {
         false => {
             let mut core = FemCore::new(&scene.scene).context("fem-node")?;
-            core.stop_on(interrupt.clone());
             if let Some(data) = setup.saved_fem() {
                 core.restore(data)
                     .context("fem-node: cannot restart from the checkpoint")?;
             }
-            Some(recorded(in_process::link("fem-node", core), &recorder, Node::Fem, info))
+            Some(core)
         }
         true => None,
     };
-    let mut sph = match scene.scene.fluid {
+    let sph_core = match scene.scene.fluid {
         Some(_) => {
             let mut core = SphCore::new(&scene.scene).context("sph-node")?;
-            core.stop_on(interrupt.clone());
             if let Some(data) = setup.saved_sph() {
                 core.restore(data)
                     .context("sph-node: cannot restart from the checkpoint")?;
             }
-            Some(recorded(in_process::link("sph-node", core), &recorder, Node::Sph, info))
+            Some(core)
         }
         None => None,
     };
+    // Ctrl-C stops the run between two steps with its outputs written (a second one ends it at once); a step still
+    // in progress 2 s after it is given up between two of its sub-steps. (Caught from here: during the set-up above
+    // Ctrl-C ends the process at once, as there is nothing to keep yet.)
+    let interrupt = Interrupt::install().context("cannot catch SIGINT and SIGTERM")?;
+    let mut fem = fem_core.map(|mut core| {
+        core.stop_on(interrupt.clone());
+        recorded(in_process::link("fem-node", core), &recorder, Node::Fem, info)
+    });
+    let mut sph = sph_core.map(|mut core| {
+        core.stop_on(interrupt.clone());
+        recorded(in_process::link("sph-node", core), &recorder, Node::Sph, info)
+    });
     let nodes = Nodes {
         fem: fem.as_deref_mut(),
         sph: sph.as_deref_mut(),
