@@ -44,10 +44,10 @@ impl FemCore {
         })
     }
 
-    /// Give up a step still in progress [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after `interrupt` arrived, between two sub-steps
-    /// ([`FemError::Stopped`]): in `cosim run --in-process`, a coupling step of minutes (a fine mesh) would hold
-    /// Ctrl-C that long. A step that ends within that time is still taken. (As a process the node need not: the
-    /// broker stops waiting for its answer.)
+    /// Give up a step still in progress [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after `interrupt` arrived,
+    /// between two sub-steps ([`FemError::Stopped`]): in `cosim run --in-process`, a coupling step of minutes (a fine
+    /// mesh) would hold Ctrl-C that long. A step that ends within that time is still taken. (As a process the node
+    /// need not: the broker stops waiting for its answer.)
     pub fn stop_on(&mut self, interrupt: Interrupt) {
         self.stop = Some(interrupt);
     }
