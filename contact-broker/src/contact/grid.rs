@@ -21,6 +21,8 @@ pub(crate) struct CellGrid {
     items: Vec<u32>,
     /// Fill cursor of the second pass (kept to reuse its allocation).
     fill: Vec<u32>,
+    /// Each item's box, evaluated once a build (kept to reuse its allocation).
+    boxes: Vec<(Vec2, Vec2)>,
 }
 
 impl CellGrid {
@@ -34,10 +36,13 @@ impl CellGrid {
         if count == 0 {
             return;
         }
+        // Each box once: the bounding box and both passes below read them.
+        let mut boxes = std::mem::take(&mut self.boxes);
+        boxes.clear();
+        boxes.extend((0..count).map(bounds));
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
-        for i in 0..count {
-            let (a, b) = bounds(i);
+        for &(a, b) in &boxes {
             for k in 0..2 {
                 lo[k] = lo[k].min(a[k]);
                 hi[k] = hi[k].max(b[k]);
@@ -64,8 +69,8 @@ impl CellGrid {
 
         // Pass 1: count items per cell; pass 2: fill (items visited in ascending order, so cells stay sorted).
         self.start.resize(ncell + 1, 0);
-        for i in 0..count {
-            let (x0, x1, y0, y1) = self.range(bounds(i));
+        for &bx in &boxes {
+            let (x0, x1, y0, y1) = self.range(bx);
             for iy in y0..=y1 {
                 for ix in x0..=x1 {
                     self.start[iy * self.nx + ix + 1] += 1;
@@ -78,8 +83,8 @@ impl CellGrid {
         self.items.resize(self.start[ncell] as usize, 0);
         self.fill.clear();
         self.fill.extend_from_slice(&self.start[..ncell]);
-        for i in 0..count {
-            let (x0, x1, y0, y1) = self.range(bounds(i));
+        for (i, &bx) in boxes.iter().enumerate() {
+            let (x0, x1, y0, y1) = self.range(bx);
             for iy in y0..=y1 {
                 for ix in x0..=x1 {
                     let c = iy * self.nx + ix;
@@ -88,6 +93,7 @@ impl CellGrid {
                 }
             }
         }
+        self.boxes = boxes;
     }
 
     /// Cell index ranges covered by a box (clamped to the grid). `max(0.0)` then the truncating cast is

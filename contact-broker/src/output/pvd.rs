@@ -10,8 +10,11 @@ use std::path::{Path, PathBuf};
 use super::{write_atomic, OutputError, Result};
 
 /// Everything before the entries.
-const HEAD: &str =
-    "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+const HEAD: &str = concat!(
+    "<?xml version=\"1.0\"?>\n",
+    "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n",
+    "  <Collection>\n"
+);
 /// Everything after them.
 const FOOT: &str = "  </Collection>\n</VTKFile>\n";
 
