@@ -56,10 +56,15 @@ impl Interrupt {
         self.flag.load(Ordering::Relaxed)
     }
 
-    /// Whether a computation in progress should be given up: the signal arrived [`STOP_WAIT`] ago or more (as
-    /// first seen here; a caller asks often, between two sub-steps).
+    /// How long ago this interrupt (or a clone) first saw the signal, counting from this call if none had; `None`
+    /// before it arrived. A caller that waits asks often (between two sub-steps, or two polls of a channel).
+    pub fn seen_for(&self) -> Option<Duration> {
+        self.arrived().then(|| self.seen.get_or_init(Instant::now).elapsed())
+    }
+
+    /// Whether a computation in progress should be given up: the signal was seen [`STOP_WAIT`] ago or more.
     pub fn overdue(&self) -> bool {
-        self.arrived() && self.seen.get_or_init(Instant::now).elapsed() >= self.wait
+        self.seen_for().is_some_and(|d| d >= self.wait)
     }
 
     /// What a run's progress callback answers (`contact_broker::coordinator::Control`): stop with [`REASON`]

@@ -19,7 +19,7 @@ use zenoh::{Session, Wait};
 
 use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
-use cosim_bus::interrupt::{Interrupt, REASON, STOP_WAIT};
+use cosim_bus::interrupt::{Interrupt, REASON};
 use cosim_bus::link_loss;
 use cosim_proto::trace::Kind;
 
@@ -111,7 +111,8 @@ pub struct ZenohLink<S, T> {
     registration: (u64, Vec<u8>),
     /// Where every message sent and accepted is recorded (`--record`).
     tap: Option<Tap>,
-    /// Ctrl-C or SIGTERM: a wait for an answer that still goes on [`STOP_WAIT`] after it is given up.
+    /// Ctrl-C or SIGTERM: a wait for an answer that still goes on
+    /// [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after it is given up.
     stop: Option<Interrupt>,
     _state: std::marker::PhantomData<T>,
 }
@@ -212,9 +213,10 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         self.tap = Some(tap);
     }
 
-    /// Give up waiting for an answer [`STOP_WAIT`] after `interrupt` arrived: a run whose coupling step takes
-    /// minutes (a fine mesh) then stops with its outputs so far written, instead of being killed by `cosim run`
-    /// with none (10 s after the Ctrl-C). A step that ends within that time is still taken.
+    /// Give up waiting for an answer [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after `interrupt` arrived
+    /// ([`Interrupt::overdue`]): a run whose coupling step takes minutes (a fine mesh) then stops with its outputs so
+    /// far written, instead of being killed by `cosim run` with none (10 s after the Ctrl-C). A step that ends within
+    /// that time is still taken.
     pub fn stop_on(&mut self, interrupt: Interrupt) {
         self.stop = Some(interrupt);
     }
@@ -392,7 +394,6 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         // A message that is not this run's answer to this step (malformed, another version, run or step) is
         // refused: logged, never applied, and the wait goes on (`docs/PROTOCOL.md` §7).
         let mut refused: Option<String> = None;
-        let mut stopped_at: Option<Instant> = None;
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
@@ -421,15 +422,12 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                 Err(e) => return Err(self.failed(format!("state channel closed: {e}"))),
             }
             self.check_node()?;
-            if self.stop.as_ref().is_some_and(Interrupt::arrived) {
-                let at = *stopped_at.get_or_insert_with(Instant::now);
-                if at.elapsed() > STOP_WAIT {
-                    return Err(self.failed(format!(
-                        "still computing coupling step {step} after {:.1} s, {:.0} s after the signal: {REASON}",
-                        started.elapsed().as_secs_f64(),
-                        at.elapsed().as_secs_f64()
-                    )));
-                }
+            if let Some(after) = self.stop.as_ref().filter(|s| s.overdue()).and_then(Interrupt::seen_for) {
+                return Err(self.failed(format!(
+                    "still computing coupling step {step} after {:.1} s, {:.0} s after the signal: {REASON}",
+                    started.elapsed().as_secs_f64(),
+                    after.as_secs_f64()
+                )));
             }
             if Instant::now() > resend_at && Instant::now() < deadline {
                 resend_at += resend_every;

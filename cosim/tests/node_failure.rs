@@ -126,6 +126,31 @@ fn signal_and_expect(
     (took, lines[0].to_string())
 }
 
+/// SIGINT to `cosim run`: it exits within 30 s, saying `words` and the signal, and its summary says `failed`,
+/// "interrupted"; the summary.
+fn interrupt_and_expect(
+    run: &mut Kill,
+    stderr_path: &std::path::Path,
+    out: &std::path::Path,
+    words: &[&str],
+) -> serde_json::Value {
+    let pid = run.0.id();
+    let words: Vec<&str> = words
+        .iter()
+        .copied()
+        .chain(["interrupted (SIGINT or SIGTERM)"])
+        .collect();
+    let (took, _) = signal_and_expect(run, pid, "-INT", stderr_path, &words);
+    assert!(took < Duration::from_secs(30), "{took:?}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "failed", "{summary}");
+    assert!(
+        summary["message"].as_str().unwrap().contains("interrupted"),
+        "{summary}"
+    );
+    summary
+}
+
 /// Runs the scene, waits for a few probe samples, sends `signal` to `victim`, and checks the clean failure.
 fn lose(name: &str, victim: &str, signal: &str, expect: &[&str]) {
     let Started {
@@ -169,22 +194,8 @@ fn interrupted() {
         } = start_with(&name, mode == "in-process");
         let kept = samples(&out);
         eprintln!("{name}: SIGINT");
-        let pid = run.0.id();
-        let (took, _) = signal_and_expect(
-            &mut run,
-            pid,
-            "-INT",
-            &stderr_path,
-            &["interrupted (SIGINT or SIGTERM)"],
-        );
-        assert!(took < Duration::from_secs(30), "{took:?}");
-        let summary = json(&out.join("summary.json"));
-        assert_eq!(summary["status"], "failed", "{summary}");
+        let summary = interrupt_and_expect(&mut run, &stderr_path, &out, &[]);
         assert_eq!(summary["mode"], mode, "{summary}");
-        assert!(
-            summary["message"].as_str().unwrap().contains("interrupted"),
-            "{summary}"
-        );
         assert!(samples(&out) >= kept, "samples lost: {} < {kept}", samples(&out));
         assert!(summary["samples"].as_u64().unwrap() >= kept as u64, "{summary}");
         assert!(out.join("plots/tip_x.svg").is_file(), "no plot written");
@@ -229,21 +240,7 @@ fn interrupt_a_long_step(in_process: bool, said: &str) {
     } = start_run(name, "scenes/csm3.toml", &sets, in_process, processes, 1);
     // Well into coupling step 1.
     std::thread::sleep(Duration::from_secs(1));
-    let pid = run.0.id();
-    let (took, _) = signal_and_expect(
-        &mut run,
-        pid,
-        "-INT",
-        &stderr_path,
-        &[said, "interrupted (SIGINT or SIGTERM)"],
-    );
-    assert!(took < Duration::from_secs(30), "{took:?}");
-    let summary = json(&out.join("summary.json"));
-    assert_eq!(summary["status"], "failed", "{summary}");
-    assert!(
-        summary["message"].as_str().unwrap().contains("interrupted"),
-        "{summary}"
-    );
+    let summary = interrupt_and_expect(&mut run, &stderr_path, &out, &[said]);
     assert_eq!(summary["samples"], 1, "{summary}");
     assert_eq!(samples(&out), 1);
     assert!(out.join("plots/tip_ux.svg").is_file(), "no plot written");

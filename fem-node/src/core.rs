@@ -111,9 +111,9 @@ impl FemCore {
         // `DEFAULT_PARALLEL_MIN_ELEMENTS`, and a parallel loop started from outside the pool hands its work to a
         // worker and sleeps, two context switches a sub-step; the same bits either way.
         let substeps = if cmd.dt > 0.0 {
-            let stop = self.stop.clone();
-            let overdue = move || stop.as_ref().is_some_and(Interrupt::overdue).then_some(REASON);
-            rayon::scope(|_| self.solver.advance_until(cmd.dt, &overdue))?
+            let (solver, stop) = (&mut self.solver, &self.stop);
+            let overdue = || stop.as_ref().is_some_and(Interrupt::overdue).then_some(REASON);
+            rayon::scope(|_| solver.advance_until(cmd.dt, &overdue))?
         } else {
             0
         };
