@@ -142,7 +142,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     summary::reserve(&args.out, &args.run, &args.mode)?;
     // The body keeps a handle of the session (a shared one: cloning it opens nothing).
     let recorder = match args.record {
-        true => Some(Recorder::begin(&args.out, &args.run, &setup)?),
+        true => Some(Recorder::begin(&args.out, &args.run, &setup, !args.ignore_disk_space)?),
         false => None,
     };
     let result = serve(&args, &setup, session.clone(), endpoints, &interrupt, recorder.as_ref());
@@ -321,17 +321,9 @@ fn serve(
     };
     let mut control = RemoteControl::declare(&session, &args.run, Box::new(must_stop), Box::new(show))?;
     let mut debugger = Debugger::new(args.break_on, &mut control);
-    let outcome = setup.run_debug(nodes, &info, &mut report, &mut debugger);
+    let mut outcome = setup.run_debug(nodes, &info, &mut report, &mut debugger);
     if let Some(r) = recorder {
-        let s = &outcome.summary;
-        r.finish(s.status.as_str(), &s.message, s.steps);
-        let cost = r.cost();
-        tracing::info!(
-            "trace: {} records, {} bytes, {:.3} s spent recording",
-            cost.records,
-            cost.bytes,
-            cost.seconds
-        );
+        r.close(&mut outcome.summary, &args.out);
     }
     board.update(|s| {
         s.health = if outcome.summary.status.is_ok() {

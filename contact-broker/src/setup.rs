@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use cosim_proto::scene::disk::DiskEstimate;
 use cosim_proto::scene::LoadedScene;
 use cosim_proto::sizing::Part;
 
@@ -57,7 +58,7 @@ impl RunSetup {
     /// Refuse a run whose outputs (frames, probe table, checkpoints; from the restart's time when it continues one)
     /// cannot fit the free space of `out`'s disk, naming the key that makes them large (`cosim_bus::disk`).
     pub fn refuse_full_disk(&self, out: &Path) -> anyhow::Result<()> {
-        let from = self.restart.as_ref().map_or(0.0, |r| r.broker.t);
+        let from = self.restart_time();
         cosim_bus::disk::refuse_above(
             &self.scene.scene,
             &self.scene.path.display().to_string(),
@@ -67,6 +68,19 @@ impl RunSetup {
             cosim_bus::disk::free(out),
         )?;
         Ok(())
+    }
+
+    /// The simulated time the run starts from: 0, or the checkpoint's.
+    pub fn restart_time(&self) -> f64 {
+        self.restart.as_ref().map_or(0.0, |r| r.broker.t)
+    }
+
+    /// The bytes the run writes into its output folder from [`RunSetup::restart_time`] to its end, as estimated
+    /// before it starts (`cosim_proto::scene::disk`; the trace of `--record` not counted).
+    pub fn outputs_bytes(&self) -> f64 {
+        let scene = &self.scene.scene;
+        let sizing = cosim_proto::scene::sizing::Sizing::of(scene);
+        DiskEstimate::of(scene, &sizing, self.checkpoint_interval, self.restart_time()).total()
     }
 
     /// The structure node's saved state to restore, when the run continues from a checkpoint.

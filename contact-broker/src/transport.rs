@@ -306,7 +306,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             .encode_checked(self.topics.command)
             .map_err(|e| self.failed(e.to_string()))?;
         if let Some(tap) = &self.tap {
-            tap.record(Kind::Command, step, &bytes);
+            tap.command(step, t, &bytes);
         }
         let bytes = ZBytes::from(bytes);
         self.command

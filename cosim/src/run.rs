@@ -163,6 +163,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             summary.mode,
             out.display()
         );
+        // `--record` that could not keep the whole run (`contact_broker::recorder`): the outputs are whole.
+        if let Some(why) = summary.trace.as_ref().and_then(|t| t.stopped.as_ref()) {
+            eprintln!("cosim: warning: the trace holds the run only in part: the recording stopped {why}");
+        }
         // Ok, but not to be trusted without a look: energy the scheme made (`contact_broker::energy_balance`).
         if let Some(g) = summary.energy_growth.as_ref().filter(|g| made_energy(g.largest)) {
             eprintln!(
@@ -267,7 +271,12 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
     let scene = &setup.scene;
     // `--record`: the messages the nodes would exchange as processes (`docs/PROTOCOL.md` §10).
     let recorder = match args.record {
-        true => Some(Recorder::begin(&info.out, &info.run_id, setup)?),
+        true => Some(Recorder::begin(
+            &info.out,
+            &info.run_id,
+            setup,
+            !args.ignore_disk_space,
+        )?),
         false => None,
     };
     let fem_core = match scene.scene.solids.is_empty() {
@@ -312,11 +321,11 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
         bar.update(p);
         interrupt.control()
     });
+    let mut summary = outcome.summary;
     if let Some(r) = &recorder {
-        let s = &outcome.summary;
-        r.finish(s.status.as_str(), &s.message, s.steps);
+        r.close(&mut summary, &info.out);
     }
-    Ok(outcome.summary)
+    Ok(summary)
 }
 
 /// `link`, its messages recorded when `recorder` is set.

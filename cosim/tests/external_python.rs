@@ -218,7 +218,7 @@ fn run_rust_twin(out: &Path, record: bool) -> f64 {
     };
     let recorder = record.then(|| {
         let setup = RunSetup::load(&root().join(SCENE), &[], Part::Run).unwrap();
-        Recorder::begin(out, &info.run_id, &setup).unwrap()
+        Recorder::begin(out, &info.run_id, &setup, true).unwrap()
     });
     let tap = |node| Tap {
         recorder: recorder.clone().unwrap(),

@@ -102,6 +102,12 @@ fn recorded_gate_replays_byte_for_byte_against_both_nodes() {
         end["bytes"].as_u64().unwrap() as usize + 8 + 10 + t.records.last().unwrap().payload.len(),
         bytes.len()
     );
+    // The summary says what the trace holds, end record included, and that it holds the whole run.
+    let note = &json(&out.join("summary.json"))["trace"];
+    assert_eq!(note["records"].as_u64(), Some(t.records.len() as u64), "{note}");
+    assert_eq!(note["bytes"].as_u64(), Some(bytes.len() as u64), "{note}");
+    assert!(note["stopped"].is_null(), "{note}");
+    assert!(json(&plain.join("summary.json"))["trace"].is_null());
 }
 
 #[test]

@@ -322,6 +322,7 @@ component = "x"
                 reaction_relaxation: None,
                 contact_step_bound: None,
                 energy_growth: None,
+                trace: None,
             },
         }
     }

@@ -5,7 +5,9 @@
 //! this process: a broker killed at any point (SIGKILL included) leaves every record it wrote readable, and at worst
 //! one record cut short at the end, which readers skip. It is not flushed to the disk (no fsync): a machine that
 //! loses power may lose the tail. A write that fails (a full disk) stops the recording with one error in the log;
-//! the run goes on.
+//! the run goes on. The recording also stops, with one error in the log, before it would take the room the run's
+//! frames, probe table and checkpoints still need on that disk, and says once beforehand when its pace will not fit
+//! to the end (`room.rs`).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,10 +18,13 @@ use anyhow::Context;
 use cosim_proto::trace::{self, Kind, Node};
 
 use crate::setup::RunSetup;
+use crate::summary::{Summary, TraceNote};
 
 mod recorded;
+mod room;
 
 pub use recorded::Recorded;
+pub use room::{FreeSpace, Room, Verdict};
 
 /// The trace's file name inside `DIR/trace/`.
 pub const FILE: &str = "trace.bin";
@@ -39,6 +44,10 @@ struct Inner {
     file: Option<std::fs::File>,
     path: PathBuf,
     cost: Cost,
+    /// The outputs' room on the trace's disk (none with `--ignore-disk-space`).
+    room: Option<Room>,
+    /// Why the recording stopped before the run's end.
+    stopped: Option<String>,
 }
 
 /// The open trace, shared by everything that records into it (the two node links and the broker itself).
@@ -47,8 +56,8 @@ pub struct Recorder(Arc<Mutex<Inner>>);
 
 impl Recorder {
     /// Create `out/trace/trace.bin` afresh (a trace of an earlier run in that folder is replaced) and write its
-    /// header.
-    pub fn create(out: &Path) -> anyhow::Result<Self> {
+    /// header. The recording stops before it takes `room` (when given) from the run's outputs.
+    pub fn create(out: &Path, room: Option<Room>) -> anyhow::Result<Self> {
         let dir = out.join("trace");
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let path = dir.join(FILE);
@@ -63,6 +72,8 @@ impl Recorder {
                 bytes: header.len() as u64,
                 ..Cost::default()
             },
+            room,
+            stopped: None,
         }))))
     }
 
@@ -70,6 +81,7 @@ impl Recorder {
     pub fn record(&self, kind: Kind, node: Node, step: u64, payload: &[u8]) {
         let started = Instant::now();
         let Ok(mut inner) = self.0.lock() else { return };
+        let inner = &mut *inner;
         let Some(file) = inner.file.as_mut() else { return };
         let written = match trace::encode(kind, node, step, payload) {
             Some(bytes) => file.write_all(&bytes).map(|()| bytes.len() as u64),
@@ -79,6 +91,15 @@ impl Recorder {
             Ok(n) => {
                 inner.cost.records += 1;
                 inner.cost.bytes += n;
+                match inner.room.as_mut().map(|room| room.after_write(n, inner.cost.bytes)) {
+                    Some(Verdict::Warn(why)) => tracing::warn!("{}: {why}", inner.path.display()),
+                    Some(Verdict::Stop(why)) => {
+                        tracing::error!("{}: {why}", inner.path.display());
+                        inner.file = None;
+                        inner.stopped = Some(format!("at step {step}: {why}"));
+                    }
+                    Some(Verdict::Go) | None => {}
+                }
             }
             Err(e) => {
                 tracing::error!(
@@ -86,15 +107,37 @@ impl Recorder {
                     inner.path.display()
                 );
                 inner.file = None;
+                inner.stopped = Some(format!("at step {step}: {e}"));
             }
         }
         inner.cost.seconds += started.elapsed().as_secs_f64();
     }
 
+    /// Append a step command of the step from simulated time `t` (the room's clock, [`Room::at`]).
+    pub fn record_command(&self, node: Node, step: u64, t: f64, payload: &[u8]) {
+        if let Ok(mut inner) = self.0.lock() {
+            let bytes = inner.cost.bytes;
+            if let Some(room) = inner.room.as_mut() {
+                room.at(t, bytes);
+            }
+        }
+        self.record(Kind::Command, node, step, payload);
+    }
+
+    /// Whether the recording still writes (it stops at a failed write or to leave the outputs their room).
+    pub fn recording(&self) -> bool {
+        self.0.lock().is_ok_and(|i| i.file.is_some())
+    }
+
     /// [`Recorder::create`], then the records a run starts with: the scene as the broker serves it, and the
-    /// broker's restore reply to each node the scene has (`docs/PROTOCOL.md` §10).
-    pub fn begin(out: &Path, run: &str, setup: &RunSetup) -> anyhow::Result<Self> {
-        let r = Self::create(out)?;
+    /// broker's restore reply to each node the scene has (`docs/PROTOCOL.md` §10). With `keep_room` the recording
+    /// stops before it takes the room the run's outputs need on the disk (`--ignore-disk-space` turns both off).
+    pub fn begin(out: &Path, run: &str, setup: &RunSetup, keep_room: bool) -> anyhow::Result<Self> {
+        let room = keep_room.then(|| {
+            let (from, end) = (setup.restart_time(), setup.scene.scene.run.end_time);
+            Room::new(&out.join("trace"), setup.outputs_bytes(), from, end)
+        });
+        let r = Self::create(out, room)?;
         let scene = &setup.scene.scene;
         r.record(Kind::Scene, Node::Broker, 0, scene.to_toml().as_bytes());
         let saved = |data: Option<&Vec<u8>>| {
@@ -140,6 +183,30 @@ impl Recorder {
         });
         self.record(Kind::End, Node::Broker, steps, end.to_string().as_bytes());
     }
+
+    /// [`Recorder::finish`] the trace of the run `summary` describes, then say in `out/summary.json` what the trace
+    /// holds and whether it stopped early (`trace`), and in the log.
+    pub fn close(&self, summary: &mut Summary, out: &Path) {
+        self.finish(summary.status.as_str(), &summary.message, summary.steps);
+        let (cost, stopped) = match self.0.lock() {
+            Ok(inner) => (inner.cost, inner.stopped.clone()),
+            Err(_) => return,
+        };
+        tracing::info!(
+            "trace: {} records, {} bytes, {:.3} s spent recording",
+            cost.records,
+            cost.bytes,
+            cost.seconds
+        );
+        summary.trace = Some(TraceNote {
+            records: cost.records,
+            bytes: cost.bytes,
+            stopped,
+        });
+        if let Err(e) = crate::summary::write(out, summary) {
+            tracing::error!("{e:#}");
+        }
+    }
 }
 
 /// A recorder bound to one node's messages.
@@ -155,5 +222,10 @@ impl Tap {
     /// Append one of this node's messages.
     pub fn record(&self, kind: Kind, step: u64, payload: &[u8]) {
         self.recorder.record(kind, self.node, step, payload);
+    }
+
+    /// Append a step command to this node, of the step from simulated time `t`.
+    pub fn command(&self, step: u64, t: f64, payload: &[u8]) {
+        self.recorder.record_command(self.node, step, t, payload);
     }
 }

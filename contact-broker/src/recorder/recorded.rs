@@ -52,7 +52,7 @@ where
 
     fn send(&mut self, step: u64, t: f64, cmd: StepCommand) -> Result<(), LinkError> {
         self.tap
-            .record(Kind::Command, step, &Envelope::new(&self.run, step, t, &cmd).encode());
+            .command(step, t, &Envelope::new(&self.run, step, t, &cmd).encode());
         self.sent = (step, t, cmd.dt);
         self.inner.send(step, t, cmd)
     }

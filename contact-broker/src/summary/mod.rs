@@ -103,6 +103,21 @@ pub struct Summary {
     /// against the energy the water can release (`energy_balance.rs`); `null` without a fluid under gravity.
     #[serde(default)]
     pub energy_growth: Option<crate::energy_balance::EnergyGrowth>,
+    /// `--record`: what the trace holds, and why it stopped before the run's end if it did; `null` without it.
+    #[serde(default)]
+    pub trace: Option<TraceNote>,
+}
+
+/// What `--record` wrote (`crate::recorder`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TraceNote {
+    /// Records in `trace/trace.bin`.
+    pub records: u64,
+    /// Its bytes.
+    pub bytes: u64,
+    /// Why the recording stopped before the run's end (a full disk, or the room the outputs needed), `null` where
+    /// it holds the whole run.
+    pub stopped: Option<String>,
 }
 
 impl Summary {
@@ -178,6 +193,7 @@ impl SummaryBuilder {
             reaction_relaxation: None,
             contact_step_bound: None,
             energy_growth: None,
+            trace: None,
         })
     }
 
