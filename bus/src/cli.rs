@@ -23,7 +23,7 @@ struct Args {
     #[arg(long)]
     listen: Vec<String>,
     /// Seconds to wait for the connection and the scene.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, value_parser = crate::seconds::positive, default_value_t = 5.0)]
     timeout: f64,
     /// Worker threads (default: all cores; 1 to 1024).
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
@@ -55,7 +55,7 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
         run: args.run,
         connect: args.connect,
         listen: args.listen,
-        timeout_ms: (args.timeout * 1000.0) as u64,
+        timeout_ms: crate::seconds::wait(args.timeout).as_millis() as u64,
         client: args.client,
         zenoh_config: args.zenoh_config,
     };

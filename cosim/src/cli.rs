@@ -121,7 +121,7 @@ pub struct RunArgs {
     #[arg(long, value_enum, value_name = "NODE")]
     pub external: Option<ExternalNode>,
     /// Seconds to wait for the external node to register (with `--external`).
-    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 300.0, value_name = "SECONDS")]
     pub wait_external: f64,
     /// Write a checkpoint, `DIR/checkpoints/<step>/` (every node's state, the broker's, the scene), every this
     /// many seconds of simulated time.
@@ -270,10 +270,10 @@ pub struct InspectArgs {
     #[arg(long, value_name = "FILE")]
     pub zenoh_config: Option<PathBuf>,
     /// Seconds to wait for the answers.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 2.0)]
     pub timeout: f64,
     /// Seconds between refreshes of the table.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 1.0)]
     pub interval: f64,
     /// Print one fluid particle's state (position, velocity, density, pressure, mass, neighbours, last contact
     /// correction) as JSON and exit.
@@ -317,7 +317,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "A")]
     pub atol: Option<f64>,
     /// Seconds to wait for the node to register, and for each of its answers.
-    #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 60.0, value_name = "SECONDS")]
     pub timeout: f64,
     /// File for the node's log (stderr); default: a file in the temporary folder, named when the replay fails.
     #[arg(long, value_name = "FILE")]

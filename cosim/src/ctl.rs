@@ -50,7 +50,7 @@ pub fn ctl(args: &CtlArgs) -> anyhow::Result<ExitCode> {
     );
     anyhow::ensure!(args.steps != Some(0), "step: give at least 1 step");
     let (session, connect) = join(&args.id, &args.join)?;
-    let timeout = Duration::from_secs_f64(args.join.timeout);
+    let timeout = cosim_bus::seconds::wait(args.join.timeout);
     let reply = match ask(&session, &args.id, command, timeout) {
         Ok(reply) => reply,
         Err(e) => {

@@ -116,7 +116,7 @@ fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     // A state is a checkpoint of every node: it may take longer than a status.
     let how = join_args(args, args.timeout.max(10.0));
     let (session, connect) = crate::join::join(&args.id, &how)?;
-    let look = match crate::look::fetch(&session, &args.id, Duration::from_secs_f64(how.timeout)) {
+    let look = match crate::look::fetch(&session, &args.id, cosim_bus::seconds::wait(how.timeout)) {
         Ok(look) => look,
         Err(e) => {
             eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
@@ -138,7 +138,7 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         return inspect_one(args);
     }
     let (session, connect) = crate::join::join(&args.id, &join_args(args, args.timeout))?;
-    let timeout = Duration::from_secs_f64(args.timeout);
+    let timeout = cosim_bus::seconds::wait(args.timeout);
     if args.once {
         let answers = query_all(&session, &args.id, timeout)?;
         if answers.is_empty() {
@@ -177,6 +177,6 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         } else {
             silent_since = None;
         }
-        std::thread::sleep(Duration::from_secs_f64(args.interval));
+        std::thread::sleep(cosim_bus::seconds::wait(args.interval));
     }
 }

@@ -25,7 +25,7 @@ pub struct JoinArgs {
     #[arg(long, value_name = "FILE")]
     pub zenoh_config: Option<PathBuf>,
     /// Seconds to wait for the run's answers.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 10.0)]
     pub timeout: f64,
 }
 
@@ -47,12 +47,7 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
             ),
         },
     };
-    anyhow::ensure!(
-        how.timeout.is_finite() && how.timeout > 0.0,
-        "--timeout must be a positive number of seconds, got {}",
-        cosim_proto::Num(how.timeout)
-    );
-    let timeout_ms = (how.timeout * 1000.0) as u64;
+    let timeout_ms = cosim_bus::seconds::wait(how.timeout).as_millis() as u64;
     let base = zenoh_config.as_deref();
     // A bad config file is its own error, not "cannot reach the run".
     base_config(base)?;

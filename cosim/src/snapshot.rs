@@ -9,7 +9,6 @@
 //! the contacts.
 
 use std::process::ExitCode;
-use std::time::Duration;
 
 use anyhow::Context;
 use contact_broker::output::{FrameWriter, Part, PointField};
@@ -21,7 +20,7 @@ use crate::look::{self, Look};
 /// Run `cosim snapshot`.
 pub fn snapshot(args: &SnapshotArgs) -> anyhow::Result<ExitCode> {
     let (session, connect) = join(&args.id, &args.join)?;
-    let look = match look::fetch(&session, &args.id, Duration::from_secs_f64(args.join.timeout)) {
+    let look = match look::fetch(&session, &args.id, cosim_bus::seconds::wait(args.join.timeout)) {
         Ok(look) => look,
         Err(e) => {
             eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);

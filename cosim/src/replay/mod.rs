@@ -167,7 +167,7 @@ impl Player {
             run: run.into(),
             topics,
             node_kind: args.node,
-            timeout: Duration::from_secs_f64(args.timeout),
+            timeout: cosim_bus::seconds::wait(args.timeout),
             setup,
             state,
             error,
