@@ -1,6 +1,9 @@
 //! Interrupts (Ctrl-C's SIGINT, SIGTERM) turned into a flag that a run reads between two steps, so that it stops
 //! there with its outputs written (summary, probes, plots, frames so far) instead of dying in the middle of a step.
-//! A second signal ends the process at once (exit code 130), for a run that does not come to its next step.
+//! A second signal ends the process at once (exit code 130), for a run that does not come to its next step; one
+//! within [`SAME_REQUEST`] of the first is the same request, not a second (`timeout` and some supervisors send
+//! SIGTERM to a process and again to its process group: the two arrive together, and the run ended at once with no
+//! summary, found 2026-12-06).
 
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -15,6 +18,9 @@ use signal_hook::consts::{SIGINT, SIGTERM};
 /// within the 10 s `cosim run` gives the broker to stop before it kills it.
 pub const STOP_WAIT: Duration = Duration::from_secs(2);
 
+/// Signals this close after the first are the same request to stop, not a second one.
+pub const SAME_REQUEST: Duration = Duration::from_millis(100);
+
 /// Set once SIGINT or SIGTERM arrived (after [`Interrupt::install`]).
 #[derive(Clone, Debug)]
 pub struct Interrupt {
@@ -26,14 +32,24 @@ pub struct Interrupt {
 }
 
 impl Interrupt {
-    /// Catch SIGINT and SIGTERM for the rest of the process's life.
+    /// Catch SIGINT and SIGTERM for the rest of the process's life: a thread of its own takes them as they come.
     pub fn install() -> std::io::Result<Self> {
         let flag = Arc::new(AtomicBool::new(false));
-        for signal in [SIGINT, SIGTERM] {
-            // The order matters: the shutdown hook sees the flag as it was before this signal set it.
-            signal_hook::flag::register_conditional_shutdown(signal, 130, Arc::clone(&flag))?;
-            signal_hook::flag::register(signal, Arc::clone(&flag))?;
-        }
+        let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM])?;
+        let raised = Arc::clone(&flag);
+        std::thread::Builder::new().name("signals".into()).spawn(move || {
+            let mut first: Option<Instant> = None;
+            for _ in signals.forever() {
+                match first {
+                    None => {
+                        first = Some(Instant::now());
+                        raised.store(true, Ordering::SeqCst);
+                    }
+                    Some(at) if at.elapsed() >= SAME_REQUEST => signal_hook::low_level::exit(130),
+                    Some(_) => {}
+                }
+            }
+        })?;
         Ok(Self::from_flag(flag))
     }
 
