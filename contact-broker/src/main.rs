@@ -53,7 +53,7 @@ struct Args {
     #[arg(long)]
     client: bool,
     /// Seconds to wait for the nodes to register.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, value_parser = cosim_bus::seconds::positive, default_value_t = 60.0)]
     wait_nodes: f64,
     /// Write a checkpoint (`DIR/checkpoints/<step>/`) every this many seconds of simulated time.
     #[arg(long, value_name = "SECONDS")]
@@ -207,8 +207,8 @@ fn serve(
     emit(serde_json::json!({"event": "listening", "endpoints": endpoints, "run": args.run}))
         .context("cannot write the listening event on stdout")?;
 
-    let wait = Duration::from_secs_f64(args.wait_nodes);
-    let step_timeout = Duration::from_secs_f64(scene.scene.coupling.step_timeout);
+    let wait = cosim_bus::seconds::wait(args.wait_nodes);
+    let step_timeout = cosim_bus::seconds::wait(scene.scene.coupling.step_timeout);
     let mut fem: Option<ZenohLink<FemMesh, FemState>> = match fem_subs {
         Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
         None => None,
