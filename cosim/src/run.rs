@@ -158,7 +158,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         println!(
             "ok: {} steps to t = {} s in {:.2} s ({}) -> {}",
             summary.steps,
-            summary.sim_time,
+            cosim_proto::Num(summary.sim_time),
             summary.wall_seconds,
             summary.mode,
             out.display()
@@ -173,9 +173,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                 "cosim: warning: the fluid and the structure gained {:.1} % of the {:.4} J/m the water can release \
                  (the most at t = {} s), which nothing in the scene supplies: the numerical scheme made it; see \
                  summary.json energy_growth",
-                100.0 * g.largest,
-                g.budget,
-                g.at
+                cosim_proto::Num(100.0 * g.largest),
+                cosim_proto::Num(g.budget),
+                cosim_proto::Num(g.at)
             );
             if let Some(h) = shorter_step(summary.sim_time, summary.steps) {
                 eprintln!(

@@ -96,7 +96,13 @@ pub(super) fn save_if_due(
 /// asked for checkpoints, the user must not find out at the restart that there are none.
 fn save(scene: &LoadedScene, nodes: &mut Nodes<'_>, info: &RunInfo, state: &BrokerState) -> anyhow::Result<()> {
     let started = Instant::now();
-    let context = || format!("checkpoint at step {} (t = {} s)", state.step, state.t);
+    let context = || {
+        format!(
+            "checkpoint at step {} (t = {} s)",
+            state.step,
+            cosim_proto::Num(state.t)
+        )
+    };
     let mut saved = Vec::new();
     if let Some(link) = nodes.fem.as_deref_mut() {
         saved.push(("fem", link.checkpoint(state.step).with_context(context)?));

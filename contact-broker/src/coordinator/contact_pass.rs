@@ -110,9 +110,12 @@ impl ContactPass {
             return Ok(());
         };
         let started = Instant::now();
-        let (corrections, stats) = interface
-            .pass(fem, sph, step.dt)
-            .with_context(|| format!("contact pass of coupling step {number} at t = {t} s"))?;
+        let (corrections, stats) = interface.pass(fem, sph, step.dt).with_context(|| {
+            format!(
+                "contact pass of coupling step {number} at t = {} s",
+                cosim_proto::Num(t)
+            )
+        })?;
         self.pending = corrections;
         self.last = stats.clone();
         self.roi = Some(interface.roi(&fem.x));

@@ -77,7 +77,7 @@ pub(super) fn exchange(
     t: f64,
     (fem_cmd, sph_cmd): (StepCommand, StepCommand),
 ) -> anyhow::Result<Round> {
-    let context = || format!("coupling step {step} from t = {t} s");
+    let context = || format!("coupling step {step} from t = {} s", cosim_proto::Num(t));
     let asked = |cmd: &StepCommand| Asked {
         interface: cmd.want_interface,
         snapshot: cmd.want_snapshot,

@@ -199,7 +199,11 @@ fn drive(
             if let Some(debugger) = debugger.as_deref_mut() {
                 let mut halt = halt_now(&clock, summary, &contact, nodes);
                 debugger.after_step(&mut halt).map_err(|why| {
-                    anyhow::anyhow!("stopped after coupling step {} (t = {} s): {why}", clock.step, clock.t)
+                    anyhow::anyhow!(
+                        "stopped after coupling step {} (t = {} s): {why}",
+                        clock.step,
+                        cosim_proto::Num(clock.t)
+                    )
                 })?;
             }
         }

@@ -47,7 +47,10 @@ pub(super) fn report(
         energy_made: summary.energy_growth.as_ref().map(|g| g.largest),
     });
     if let Control::Break(why) = control {
-        anyhow::bail!("stopped after coupling step {step} (t = {t} s): {why}");
+        anyhow::bail!(
+            "stopped after coupling step {step} (t = {} s): {why}",
+            cosim_proto::Num(t)
+        );
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ use anyhow::Context;
 
 use cosim_proto::messages::{FemMesh, FemSnapshot, SphSetup, SphSnapshot};
 use cosim_proto::scene::LoadedScene;
+use cosim_proto::Num;
 use sph_node::eos::Tait;
 
 use super::exchange::Round;
@@ -182,13 +183,14 @@ fn energy_balance(
                 )
             });
             tracing::warn!(
-                "by t = {t} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m \
+                "by t = {} s the fluid and the structure together have gained {:.4} J/m, {:.1} % of the {:.4} J/m \
                  the water can release: nothing in the scene supplies it, so the scheme made it (an unstable \
                  coupling, or a step too long for it); what follows may be unphysical (summary.json \
                  energy_growth){hint}",
-                growth.largest * growth.budget,
-                100.0 * growth.largest,
-                growth.budget
+                Num(t),
+                Num(growth.largest * growth.budget),
+                Num(100.0 * growth.largest),
+                Num(growth.budget)
             );
         }
     }

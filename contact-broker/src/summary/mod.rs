@@ -154,7 +154,11 @@ impl Summary {
             }
             None => {
                 self.status = RunStatus::Ok;
-                self.message = format!("reached t = {} s in {} steps", self.sim_time, self.steps);
+                self.message = format!(
+                    "reached t = {} s in {} steps",
+                    cosim_proto::Num(self.sim_time),
+                    self.steps
+                );
             }
         }
         self.wall_seconds = wall_seconds;
