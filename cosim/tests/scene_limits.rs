@@ -88,19 +88,19 @@ fn a_run_that_could_never_end_is_refused_naming_the_key() {
     );
     both_refuse(
         "scenes/dam_break.toml",
-        &["fluid.kinematic_viscosity=1e300"],
+        &["fluid.kinematic_viscosity=1e40"],
         &[
             "fluid.kinematic_viscosity",
-            "1e300 m²/s",
-            "8.450e-307 s",
+            "1e40 m²/s",
+            "8.450e-47 s",
             "fluid steps",
             "1e12",
         ],
     );
     both_refuse(
         "scenes/elastic_gate.toml",
-        &["fluid.sound_speed=1e300"],
-        &["fluid.sound_speed", "1e300 m/s", "0.25 h/c0"],
+        &["fluid.sound_speed=1e40"],
+        &["fluid.sound_speed", "1e40 m/s", "0.25 h/c0"],
     );
     // The broker started by hand (a run over several hosts) refuses it the same way, as bad input.
     let out_dir = scratch("limits-broker");

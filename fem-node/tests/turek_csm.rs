@@ -120,3 +120,23 @@ fn csm1_static_tip_deflection_matches_turek() {
     assert!(rel_err(uy_end, ry) < 0.02, "CSM1 uy {uy_end} vs {ry}");
     assert!(rel_err(ux_end, rx) < 0.05, "CSM1 ux {ux_end} vs {rx}");
 }
+
+/// Mass-proportional damping far beyond critical: the explicit kick multiplies a free velocity by 1 − c Δt, so the
+/// step is held to `cfl / c` and the bar creeps down at about g/c instead of blowing up (c = 1e6/s: at the undamped
+/// step, ~2.6e-5 s, c Δt was 26 and the bar was non-finite within a few steps). A bar damped as CSM1 damps it keeps
+/// its undamped step, bit for bit.
+#[test]
+fn an_overdamped_bar_is_stepped_within_its_damping_and_creeps() {
+    let undamped = solver(bar(0.0), [0.0, -2.0], 0.9).stable_dt();
+    assert_eq!(solver(bar(10.0), [0.0, -2.0], 0.9).stable_dt(), undamped);
+    let c = 1e6;
+    let mut s = solver(bar(c), [0.0, -2.0], 0.9);
+    assert!(undamped > 10.0 * 0.9 / c, "{undamped}");
+    assert_eq!(s.stable_dt(), 0.9 / c);
+    let a = s.model().nearest_node(0, POINT_A).unwrap();
+    let t = 1e-3;
+    s.advance(t).unwrap();
+    let uy = s.state().x[a][1] - POINT_A[1];
+    // Terminal creep g/c: 2e-6 m/s over 1 ms is 2e-9 m; the bar's stiffness only slows it.
+    assert!(uy.is_finite() && uy < 0.0 && uy > -2.0 / c * t * 1.01, "uy = {uy}");
+}

@@ -10,6 +10,11 @@
 //!
 //! With stiffness-proportional damping β an element's step is shortened by `√(1 + ζ²) − ζ`, ζ = β c_d / L_e its
 //! damping ratio at ω = 2 c_d / L_e (Belytschko, Liu & Moran, Nonlinear Finite Elements, Eq. 6.2.32).
+//!
+//! Mass-proportional damping c (`solid[i].damping`, the force −c m v taken at v^{n+½}) multiplies a free velocity by
+//! 1 − c Δt a step (`central_difference.rs`): past c Δt = 2 it grows, past 1 it flips sign every step. So the step
+//! is also at most `cfl / c`. It binds only for a structure damped far beyond critical at its own step (c = 10/s
+//! against Δt ~ 1e-5 s on the CSM bar: c Δt = 1e-4); before, c = 1e300 blew the structure up at its second step.
 
 use crate::model::FemModel;
 
@@ -18,6 +23,9 @@ use crate::model::FemModel;
 pub fn stable_dt(model: &FemModel, x: &[[f64; 2]], cfl: f64) -> Result<f64, (usize, f64)> {
     let mut dt = f64::INFINITY;
     for solid in model.solids() {
+        if solid.damping > 0.0 {
+            dt = dt.min(cfl / solid.damping);
+        }
         let c = solid.wave_speed();
         for e in solid.elements.clone() {
             let l = model.elements()[e].characteristic_length(x);

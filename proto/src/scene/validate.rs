@@ -3,17 +3,57 @@
 
 use std::collections::HashSet;
 
-use super::schema::{
-    ContactAlgorithm, FluidSolver, ProbeKind, Scene, FLUID_SUBSTEPS_MAX, SCENE_VERSION, STRUCTURE_COURANT_MIN,
-};
+use super::schema::{ContactAlgorithm, FluidSolver, Scene, FLUID_SUBSTEPS_MAX, SCENE_VERSION, STRUCTURE_COURANT_MIN};
 use super::sizing::Sizing;
 use crate::{overlap, Num};
 
 mod fluid;
 mod probe_point;
+mod probes;
 mod solid;
 
 type Invalid = (String, String);
+
+/// The smallest factor on a stable step (`fluid.cfl`, `coupling.fem_cfl`): below it a step so short that 1/Δt²
+/// (ISPH's pressure equation) overflows.
+const CFL_MIN: f64 = 1e-6;
+
+/// `contact.thickness` = `t` against the fluid spacing `dx`, per algorithm (the gate at Δx = 2 mm to 0.05 s,
+/// 2026-12-06): `particle_element` ran from Δx/100 to 0.75 Δx, gained energy at Δx and went unstable at 2 Δx and
+/// past 5 Δx pushed particles out of the domain (past 1e10 m it found no contact at all and the water went through
+/// the gate); `particle_particle` puts its force's range r0 at the thickness and its boundary points half of it
+/// apart, so past Δx/2 the particles start inside the force (unstable at the second step at 0.75 Δx), at Δx/100
+/// its stiffness, ∝ 1/r0², went unstable after 7 ms, and at 1e-8 m the points filled the memory.
+fn thickness(t: f64, dx: f64, algorithm: ContactAlgorithm) -> Result<(), Invalid> {
+    let (lo, hi, why) = match algorithm {
+        ContactAlgorithm::ParticleElement => (
+            0.01,
+            1.0,
+            "thicker, the contact reaches particles that are not touching and the coupled run gains energy",
+        ),
+        ContactAlgorithm::ParticleParticle => (
+            0.1,
+            0.5,
+            "its force's range is the thickness, so thicker, the fluid particles (half a spacing from the \
+             structure) start inside it; thinner, its stiffness (∝ 1/thickness²) outruns the step",
+        ),
+        ContactAlgorithm::None => return Ok(()),
+    };
+    check(
+        (lo * dx..=hi * dx).contains(&t),
+        || "contact.thickness".into(),
+        || {
+            format!(
+                "{} m is outside [{lo} × spacing, {hi} × spacing] = [{}, {}] m for contact.algorithm = \"{}\" \
+                 (default spacing / 2): {why}",
+                Num(t),
+                Num(lo * dx),
+                Num(hi * dx),
+                algorithm.name()
+            )
+        },
+    )
+}
 
 fn check(ok: bool, key: impl FnOnce() -> String, message: impl FnOnce() -> String) -> Result<(), Invalid> {
     if ok {
@@ -28,6 +68,39 @@ fn finite_positive(key: &str, v: f64) -> Result<(), Invalid> {
         v.is_finite() && v > 0.0,
         || key.to_string(),
         || format!("must be a positive number, got {}", Num(v)),
+    )
+}
+
+/// The magnitudes a physical value of a scene may take, [1e-50, 1e50] (or 0 where the key allows it): the solvers
+/// square and multiply them (ρ c0², ρ², E / ρ, h⁻³ …), and products of a few of them must stay finite and normal
+/// in double precision. Past it a run ended "unstable at step 1" or with a NaN in a message, naming no key (found
+/// 2026-12-06 by a sweep of extreme values: fluid.density = 1e300, fluid.sound_speed = 1e-300, run.gravity = 1e300).
+pub const MAGNITUDES: [f64; 2] = [1e-50, 1e50];
+
+/// `v` (finite) is zero or within [`MAGNITUDES`] in magnitude.
+fn magnitude(key: &str, v: f64, unit: &str) -> Result<(), Invalid> {
+    let a = v.abs();
+    check(
+        a == 0.0 || (MAGNITUDES[0]..=MAGNITUDES[1]).contains(&a),
+        || key.to_string(),
+        || {
+            format!(
+                "{} {unit} is outside the magnitudes this build computes with, {:e} to {:e} (their squares and \
+                 products must stay finite in double precision)",
+                Num(v),
+                MAGNITUDES[0],
+                MAGNITUDES[1]
+            )
+        },
+    )
+}
+
+/// Every coordinate of the box `min`–`max` (finite) is within [`MAGNITUDES`]' largest magnitude.
+fn coordinates(key: &str, min: [f64; 2], max: [f64; 2]) -> Result<(), Invalid> {
+    check(
+        min.iter().chain(&max).all(|v| v.abs() <= MAGNITUDES[1]),
+        || key.to_string(),
+        || format!("corners min {min:?} max {max:?} lie beyond ±{:e} m", MAGNITUDES[1]),
     )
 }
 
@@ -82,13 +155,16 @@ impl Scene {
             || "run.gravity".into(),
             || "must be finite".into(),
         )?;
+        for g in self.run.gravity {
+            magnitude("run.gravity", g, "m/s²")?;
+        }
         finite_positive("coupling.max_dt", self.coupling.max_dt)?;
         finite_positive("coupling.step_timeout", self.coupling.step_timeout)?;
         check(
             // Above 0.94 elongated tri3 meshes go unstable (their characteristic length is an estimate).
-            self.coupling.fem_cfl > 0.0 && self.coupling.fem_cfl <= 0.9,
+            (CFL_MIN..=0.9).contains(&self.coupling.fem_cfl),
             || "coupling.fem_cfl".into(),
-            || format!("must be in (0, 0.9], got {}", Num(self.coupling.fem_cfl)),
+            || format!("must be in [{CFL_MIN:e}, 0.9], got {}", Num(self.coupling.fem_cfl)),
         )?;
         check(
             self.coupling.structure_courant == 0.0
@@ -146,6 +222,29 @@ impl Scene {
                 },
             )?;
         }
+        // Walls and solids first: the fluid's blocks are checked against them.
+        for (w, wall) in self.walls.iter().enumerate() {
+            check(
+                (0..2).all(|k| wall.min[k].is_finite() && wall.max[k].is_finite() && wall.max[k] > wall.min[k]),
+                || format!("wall[{w}].max"),
+                || {
+                    format!(
+                        "must be greater than min in every component, got min {:?} max {:?}",
+                        wall.min, wall.max
+                    )
+                },
+            )?;
+            coordinates(&format!("wall[{w}]"), wall.min, wall.max)?;
+        }
+        let mut solids = HashSet::with_capacity(self.solids.len());
+        for (s, solid) in self.solids.iter().enumerate() {
+            solid::validate_solid(s, solid)?;
+            check(
+                solids.insert(solid.name.as_str()),
+                || format!("solid[{s}].name"),
+                || format!("`{}` is used by another solid", solid.name),
+            )?;
+        }
         if let Some(fluid) = &self.fluid {
             fluid::validate_fluid(fluid, &self.walls, &self.solids)?;
             // c0 defaults to 10 sqrt(2 g H) (`sph_node::setup::sound_speed`): WCSPH always needs it, ISPH for the
@@ -158,27 +257,9 @@ impl Scene {
                 || "fluid.sound_speed".into(),
                 || "cannot default to 10 sqrt(2 g H) without gravity (run.gravity is [0, 0]); give a value".into(),
             )?;
-        }
-        for (w, wall) in self.walls.iter().enumerate() {
-            check(
-                (0..2).all(|k| wall.min[k].is_finite() && wall.max[k].is_finite() && wall.max[k] > wall.min[k]),
-                || format!("wall[{w}].max"),
-                || {
-                    format!(
-                        "must be greater than min in every component, got min {:?} max {:?}",
-                        wall.min, wall.max
-                    )
-                },
-            )?;
-        }
-        let mut solids = HashSet::with_capacity(self.solids.len());
-        for (s, solid) in self.solids.iter().enumerate() {
-            solid::validate_solid(s, solid)?;
-            check(
-                solids.insert(solid.name.as_str()),
-                || format!("solid[{s}].name"),
-                || format!("`{}` is used by another solid", solid.name),
-            )?;
+            if let (Some(t), false) = (self.contact.thickness, self.solids.is_empty()) {
+                thickness(t, fluid.spacing, self.contact.algorithm)?;
+            }
         }
         let rects: Vec<overlap::Rect> = self.solids.iter().map(|s| (s.min, s.max)).collect();
         if let Some((a, b)) = overlap::first_overlap(&rects) {
@@ -192,164 +273,8 @@ impl Scene {
                 ),
             ));
         }
-        let mut names = HashSet::with_capacity(self.probes.len());
-        for (p, probe) in self.probes.iter().enumerate() {
-            let key = |k: &str| format!("probe[{p}].{k}");
-            check(
-                !probe.name.trim().is_empty() && !probe.name.contains(','),
-                || key("name"),
-                || "must be non-empty and contain no comma".into(),
-            )?;
-            check(
-                names.insert(probe.name.as_str()),
-                || key("name"),
-                || format!("`{}` is used by another probe", probe.name),
-            )?;
-            let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
-            check(
-                probe.point.is_none_or(|p| finite(&p)),
-                || key("point"),
-                || format!("must be finite, got {:?}", probe.point.unwrap_or_default()),
-            )?;
-            check(
-                probe.x_max.is_none_or(f64::is_finite),
-                || key("x_max"),
-                || format!("must be finite, got {}", Num(probe.x_max.unwrap_or_default())),
-            )?;
-            if let Some(name) = &probe.solid {
-                check(
-                    solids.contains(name.as_str()),
-                    || key("solid"),
-                    || format!("no solid named `{name}` (solids: {})", self.solid_names()),
-                )?;
-            }
-            match probe.kind {
-                ProbeKind::NodeDisplacement => {
-                    check(
-                        probe.solid.is_some(),
-                        || key("solid"),
-                        || "missing key (node_displacement)".into(),
-                    )?;
-                    check(
-                        probe.point.is_some(),
-                        || key("point"),
-                        || "missing key (node_displacement)".into(),
-                    )?;
-                    let on = self.solids.iter().find(|s| Some(&s.name) == probe.solid.as_ref());
-                    if let (Some(point), Some(solid)) = (probe.point, on) {
-                        probe_point::on_solid(p, point, solid)?;
-                    }
-                    check(
-                        probe.component.is_some(),
-                        || key("component"),
-                        || "missing key (node_displacement)".into(),
-                    )?;
-                }
-                ProbeKind::Energy => {
-                    check(probe.part.is_some(), || key("part"), || "missing key (energy)".into())?;
-                }
-                ProbeKind::InterfaceLoad => {
-                    check(
-                        !self.solids.is_empty() && self.fluid.is_some(),
-                        || key("kind"),
-                        || "needs a [[solid]] and a [fluid] in the scene".into(),
-                    )?;
-                    check(
-                        probe.component.is_some(),
-                        || key("component"),
-                        || "missing key (interface_load)".into(),
-                    )?;
-                }
-                ProbeKind::SurgeFront | ProbeKind::ColumnHeight | ProbeKind::Pressure | ProbeKind::WaterLevel => {
-                    check(
-                        self.fluid.is_some(),
-                        || key("kind"),
-                        || "needs a [fluid] in the scene".into(),
-                    )?;
-                    let (needed, present) = match probe.kind {
-                        ProbeKind::SurgeFront => ("component", probe.component.is_some()),
-                        ProbeKind::ColumnHeight => ("x_max", probe.x_max.is_some_and(f64::is_finite)),
-                        _ => ("point", probe.point.is_some()),
-                    };
-                    check(
-                        present,
-                        || key(needed),
-                        || format!("missing key ({:?})", probe.kind).to_lowercase(),
-                    )?;
-                    if let (ProbeKind::ColumnHeight, Some(x_max), Some(fluid)) = (probe.kind, probe.x_max, &self.fluid)
-                    {
-                        // The first column of particles of a block is half a spacing inside it (sph-node setup).
-                        let first = fluid
-                            .blocks
-                            .iter()
-                            .map(|b| b.min[0] + 0.5 * fluid.spacing)
-                            .fold(f64::INFINITY, f64::min);
-                        check(
-                            x_max >= first,
-                            || key("x_max"),
-                            || {
-                                format!(
-                                    "{} is left of every fluid particle (the first are at x = {}): the column \
-                                     would be empty from the start",
-                                    Num(x_max),
-                                    Num(first)
-                                )
-                            },
-                        )?;
-                    }
-                }
-            }
-            // A sensor's face and time mean (pressure probes only).
-            for (k, present) in [
-                ("radius", probe.radius.is_some()),
-                ("normal", probe.normal.is_some()),
-                ("average", probe.average.is_some()),
-            ] {
-                check(
-                    !present || probe.kind == ProbeKind::Pressure,
-                    || key(k),
-                    || "only a pressure probe takes this key".into(),
-                )?;
-            }
-            if let Some(r) = probe.radius {
-                check(
-                    r.is_finite() && r >= 0.0,
-                    || key("radius"),
-                    || format!("must be a finite length >= 0, got {}", Num(r)),
-                )?;
-                let n = probe.normal.unwrap_or([0.0, 0.0]);
-                check(
-                    r == 0.0 || (finite(&n) && n[0].hypot(n[1]) > 0.0),
-                    || key("normal"),
-                    || match probe.normal {
-                        None => "missing key (a face with radius > 0 needs the normal it lies across)".into(),
-                        Some(n) => format!("must be a finite non-zero vector, got {n:?}"),
-                    },
-                )?;
-            }
-            if let Some(r) = &probe.reference {
-                finite_positive(&key("reference.scale"), r.scale.abs())?;
-                for (k, v) in [("t_scale", r.t_scale), ("t_offset", r.t_offset)] {
-                    check(
-                        v.is_finite(),
-                        || key(&format!("reference.{k}")),
-                        || format!("must be finite, got {}", Num(v)),
-                    )?;
-                }
-            }
-        }
+        probes::validate_probes(self, &solids)?;
         // Last: the counts are meaningful once every number above is known to be finite and positive.
         Sizing::of(self).check_counts()
-    }
-
-    fn solid_names(&self) -> String {
-        if self.solids.is_empty() {
-            return "none".into();
-        }
-        self.solids
-            .iter()
-            .map(|s| s.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
     }
 }

@@ -1,19 +1,26 @@
 //! The `[fluid]` section: sizes, corrections, solver options, and blocks that hold particles and stay out of the
 //! walls and solids.
 
-use super::{check, finite_positive, Invalid};
+use super::{check, coordinates, finite_positive, magnitude, Invalid, CFL_MIN};
 use crate::scene::schema::{BoxSpec, DensityFilter, FluidSolver, FluidSpec, SolidSpec, ISPH_PPE_TOLERANCE_RANGE};
 use crate::Num;
+
+/// The largest artificial viscosity α: its kinematic viscosity α h c0 / 8 (2D) holds the step to 0.125 h² / ν =
+/// h / (α c0), which is the acoustic step 0.25 h / c0 at α = 4.
+const ARTIFICIAL_VISCOSITY_MAX: f64 = 4.0;
 
 /// The fluid section: positive sizes, a sensible smoothing ratio, blocks that hold particles and stay out of walls.
 pub(super) fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSpec]) -> Result<(), Invalid> {
     finite_positive("fluid.density", f.density)?;
+    magnitude("fluid.density", f.density, "kg/m³")?;
+    // A tiny spacing is refused by the particles it makes (`sizing.rs`), a large one by the blocks it leaves empty.
     finite_positive("fluid.spacing", f.spacing)?;
     check(
         f.kinematic_viscosity.is_finite() && f.kinematic_viscosity >= 0.0,
         || "fluid.kinematic_viscosity".into(),
         || format!("must be zero or positive, got {}", Num(f.kinematic_viscosity)),
     )?;
+    magnitude("fluid.kinematic_viscosity", f.kinematic_viscosity, "m²/s")?;
     check(
         (1.0..=2.0).contains(&f.smoothing_ratio),
         || "fluid.smoothing_ratio".into(),
@@ -26,22 +33,29 @@ pub(super) fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSp
     )?;
     if let Some(c) = f.sound_speed {
         finite_positive("fluid.sound_speed", c)?;
+        magnitude("fluid.sound_speed", c, "m/s")?;
     }
     check(
-        f.cfl.is_finite() && f.cfl > 0.0 && f.cfl <= 1.0,
+        (CFL_MIN..=1.0).contains(&f.cfl),
         || "fluid.cfl".into(),
         || {
             format!(
-                "must be in (0, 1] (a factor on the stable step of DESIGN.md §4.2/§4.3; above 1 the fluid is \
-                 stepped past its stability limit), got {}",
+                "must be in [{CFL_MIN:e}, 1] (a factor on the stable step of DESIGN.md §4.2/§4.3; above 1 the fluid \
+                 is stepped past its stability limit), got {}",
                 Num(f.cfl)
             )
         },
     )?;
     check(
-        f.artificial_viscosity.is_finite() && f.artificial_viscosity >= 0.0,
+        (0.0..=ARTIFICIAL_VISCOSITY_MAX).contains(&f.artificial_viscosity),
         || "fluid.artificial_viscosity".into(),
-        || format!("must be zero or positive, got {}", Num(f.artificial_viscosity)),
+        || {
+            format!(
+                "must be in [0, {ARTIFICIAL_VISCOSITY_MAX}] (Monaghan's α; 0.01–0.1 is usual; past 4 its viscosity, \
+                 α h c0 / 8, needs a shorter step than the acoustic one the solver takes), got {}",
+                Num(f.artificial_viscosity)
+            )
+        },
     )?;
     check(
         f.density_filter_interval >= 1,
@@ -126,6 +140,7 @@ pub(super) fn validate_fluid(f: &FluidSpec, walls: &[BoxSpec], solids: &[SolidSp
             key,
             || "corners must be finite".into(),
         )?;
+        coordinates(&key(), block.min, block.max)?;
         check((0..2).all(|k| block.max[k] - block.min[k] >= f.spacing), key, || {
             format!(
                 "holds no particle: min {:?} max {:?} is narrower than the spacing {}",

@@ -1,6 +1,6 @@
 //! One `[[solid]]`: its name, rectangle, mesh, material, damping and clamps.
 
-use super::{check, finite_positive, Invalid};
+use super::{check, coordinates, finite_positive, magnitude, Invalid};
 use crate::scene::schema::SolidSpec;
 use crate::Num;
 
@@ -23,6 +23,7 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
                 )
             },
         )?;
+        coordinates(&key("max"), solid.min, solid.max)?;
         check(
             solid.divisions[k] > 0,
             || key("divisions"),
@@ -31,7 +32,9 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
     }
     let m = &solid.material;
     finite_positive(&key("material.density"), m.density)?;
+    magnitude(&key("material.density"), m.density, "kg/m³")?;
     finite_positive(&key("material.youngs_modulus"), m.youngs_modulus)?;
+    magnitude(&key("material.youngs_modulus"), m.youngs_modulus, "Pa")?;
     check(
         m.poisson_ratio.is_finite() && (0.0..0.5).contains(&m.poisson_ratio),
         || key("material.poisson_ratio"),
@@ -42,6 +45,7 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
         || key("damping"),
         || format!("must be zero or positive, got {}", Num(solid.damping)),
     )?;
+    magnitude(&key("damping"), solid.damping, "1/s")?;
     check(
         solid.mesh_damping.is_finite() && (0.0..1.0).contains(&solid.mesh_damping),
         || key("mesh_damping"),
