@@ -440,7 +440,9 @@ fn isph_at_large_steps(factor: f64, end: f64) -> LargeStep {
         .unwrap()
         .scene;
     let mut solver = sph_node::IsphSolver::new(&scene).unwrap();
-    let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity);
+    // As the node builds it: the fluid's sound speed sets the guard's quiet floor.
+    let c0 = sph_node::setup::sound_speed(scene.fluid.as_ref().unwrap(), scene.run.gravity).ok();
+    let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity, c0);
     let e0 = solver.kinetic_energy() + solver.potential_energy();
     let budget = budget(&TALL_BLOCKS);
     let mut growth = f64::NEG_INFINITY;

@@ -100,7 +100,12 @@ impl SphCore {
             sensors: sensors.len() as u32,
             ..setup
         };
-        let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity);
+        // The guard's quiet floor needs the fluid's sound speed (WCSPH's c0; ISPH's where the scene gives one).
+        let c0 = scene
+            .fluid
+            .as_ref()
+            .and_then(|f| crate::setup::sound_speed(f, scene.run.gravity).ok());
+        let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity, c0);
         Ok(Self {
             solver,
             setup,
