@@ -280,7 +280,8 @@ fn extreme_values_are_said_in_scientific_notation() {
     for (set, said) in [
         ("solid[0].material.youngs_modulus=-1e300", "got -1e300"),
         ("fluid.cfl=1e300", "got 1e300"),
-        ("run.end_time=1e300", "1.1e286 EiB of memory"),
+        ("run.end_time=1e40", "1.1e26 EiB of memory"),
+        ("run.end_time=1e300", "run.end_time: 1e300 s is outside the magnitudes"),
         ("fluid.spacing=1e-300", "fluid.spacing: 1e-300 m makes"),
     ] {
         let out = cosim("check", "scenes/elastic_gate.toml", &[set], LIMIT);

@@ -133,6 +133,7 @@ impl Scene {
             || "nothing to run: the scene has no [[solid]] and no [fluid]".into(),
         )?;
         finite_positive("run.end_time", self.run.end_time)?;
+        magnitude("run.end_time", self.run.end_time, "s")?;
         finite_positive("run.output_interval", self.run.output_interval)?;
         if let Some(f) = self.run.frame_interval {
             finite_positive("run.frame_interval", f)?;
