@@ -1,9 +1,9 @@
 //! A run that could never end is refused before it starts. Every step of a run costs at least microseconds, so a
-//! scene whose numbers need more than [`MAX_STEPS`] steps — a `coupling.max_dt` of 1e-300, a viscosity of 1e300
-//! m²/s that holds the fluid's step to 1e-307 s — would hold its processes busy for longer than any machine runs;
+//! scene whose numbers need more than [`MAX_STEPS`] steps — a `coupling.max_dt` of 1e-300, a viscosity of 1e40
+//! m²/s that holds the fluid's step to 8e-47 s — would hold its processes busy for longer than any machine runs;
 //! `cosim check`, `cosim run` and `contact-broker` say so with the key, as bad input (exit 2). Counted from what
 //! bounds a step whatever the motion (`coupling.max_dt`; the fluid's acoustic and viscous conditions,
-//! `sph_node::time_step::longest`), so a run refused here could not have been shorter. What the motion does later
+//! `sph_node::time_step::longest`; each structure's explicit step), so a run refused here could not have been shorter. What the motion does later
 //! (a fluid blowing up, its step collapsing) the nodes catch themselves: neither sub-cycles more than 2^32 steps
 //! within one coupling step.
 
@@ -14,10 +14,14 @@ use cosim_proto::Num;
 /// The most steps of one kind a run may need: at 1 µs a step, 12 days.
 pub const MAX_STEPS: f64 = 1e12;
 
+/// More steps than a run may take (or a count that is not a number).
+fn too_many(steps: f64) -> bool {
+    steps.is_nan() || steps > MAX_STEPS
+}
+
 /// `Err((key, what))` where `scene` needs more than [`MAX_STEPS`] coupling or fluid steps.
 pub fn refuse_endless(scene: &Scene) -> Result<(), (String, String)> {
     let end = scene.run.end_time;
-    let too_many = |n: f64| n.is_nan() || n > MAX_STEPS;
     let coupling = end / scene.coupling.max_dt;
     if too_many(coupling) {
         return Err((
@@ -90,7 +94,7 @@ fn structure(s: usize, solid: &SolidSpec, fem_cfl: f64, end: f64) -> Result<(), 
         false => f64::INFINITY,
     };
     let steps = end / (fem_cfl * elastic.min(damped));
-    if !(steps.is_nan() || steps > MAX_STEPS) {
+    if !too_many(steps) {
         return Ok(());
     }
     let why = |key: String, what: String, dt: f64| {
@@ -107,7 +111,7 @@ fn structure(s: usize, solid: &SolidSpec, fem_cfl: f64, end: f64) -> Result<(), 
         let what = format!("{} 1/s (a step of at most coupling.fem_cfl / c)", Num(solid.damping));
         return why(format!("solid[{s}].damping"), what, dt);
     }
-    if end / (0.9 * elastic) <= MAX_STEPS {
+    if !too_many(end / (0.9 * elastic)) {
         return why("coupling.fem_cfl".into(), format!("{}", Num(fem_cfl)), dt);
     }
     let what = format!(

@@ -24,7 +24,7 @@ mod recorded;
 mod room;
 
 pub use recorded::Recorded;
-pub use room::{FreeSpace, Room, Verdict};
+use room::{Room, Verdict};
 
 /// The trace's file name inside `DIR/trace/`.
 pub const FILE: &str = "trace.bin";
@@ -57,7 +57,7 @@ pub struct Recorder(Arc<Mutex<Inner>>);
 impl Recorder {
     /// Create `out/trace/trace.bin` afresh (a trace of an earlier run in that folder is replaced) and write its
     /// header. The recording stops before it takes `room` (when given) from the run's outputs.
-    pub fn create(out: &Path, room: Option<Room>) -> anyhow::Result<Self> {
+    fn create(out: &Path, room: Option<Room>) -> anyhow::Result<Self> {
         let dir = out.join("trace");
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let path = dir.join(FILE);
@@ -79,9 +79,22 @@ impl Recorder {
 
     /// Append one record. Never fails the run: a write error stops the recording and is logged once.
     pub fn record(&self, kind: Kind, node: Node, step: u64, payload: &[u8]) {
+        self.write(kind, node, step, payload, None);
+    }
+
+    /// Append a step command of the step from simulated time `t` (the room's clock, [`Room::at`]).
+    pub fn record_command(&self, node: Node, step: u64, t: f64, payload: &[u8]) {
+        self.write(Kind::Command, node, step, payload, Some(t));
+    }
+
+    /// One record, after moving the room's clock to `t` (a command's).
+    fn write(&self, kind: Kind, node: Node, step: u64, payload: &[u8], t: Option<f64>) {
         let started = Instant::now();
         let Ok(mut inner) = self.0.lock() else { return };
         let inner = &mut *inner;
+        if let (Some(room), Some(t)) = (inner.room.as_mut(), t) {
+            room.at(t, inner.cost.bytes);
+        }
         let Some(file) = inner.file.as_mut() else { return };
         let written = match trace::encode(kind, node, step, payload) {
             Some(bytes) => file.write_all(&bytes).map(|()| bytes.len() as u64),
@@ -111,22 +124,6 @@ impl Recorder {
             }
         }
         inner.cost.seconds += started.elapsed().as_secs_f64();
-    }
-
-    /// Append a step command of the step from simulated time `t` (the room's clock, [`Room::at`]).
-    pub fn record_command(&self, node: Node, step: u64, t: f64, payload: &[u8]) {
-        if let Ok(mut inner) = self.0.lock() {
-            let bytes = inner.cost.bytes;
-            if let Some(room) = inner.room.as_mut() {
-                room.at(t, bytes);
-            }
-        }
-        self.record(Kind::Command, node, step, payload);
-    }
-
-    /// Whether the recording still writes (it stops at a failed write or to leave the outputs their room).
-    pub fn recording(&self) -> bool {
-        self.0.lock().is_ok_and(|i| i.file.is_some())
     }
 
     /// [`Recorder::create`], then the records a run starts with: the scene as the broker serves it, and the

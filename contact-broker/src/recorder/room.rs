@@ -62,7 +62,8 @@ impl Room {
         }
     }
 
-    /// The same, with the free space read by `free` (tests).
+    /// The same, with the free space read by `free`.
+    #[cfg(test)]
     pub fn with_free(mut self, free: FreeSpace) -> Self {
         self.free = free;
         self

@@ -23,13 +23,13 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
                 )
             },
         )?;
-        coordinates(&key("max"), solid.min, solid.max)?;
         check(
             solid.divisions[k] > 0,
             || key("divisions"),
             || format!("must be at least 1 in every component, got {:?}", solid.divisions),
         )?;
     }
+    coordinates(&key("max"), solid.min, solid.max)?;
     let m = &solid.material;
     finite_positive(&key("material.density"), m.density)?;
     magnitude(&key("material.density"), m.density, "kg/m³")?;
