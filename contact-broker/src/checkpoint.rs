@@ -38,8 +38,9 @@ pub use broker_state::BrokerState;
 /// interface_load probes' impulse since the last sample (`BrokerState::load_log`); 4: the contact impulse owed to the
 /// structure (`BrokerState::owed`); 5: the contact's bound on the coupling step (`BrokerState::dt_contact`); 6: the
 /// run's energy balance (`Summary::energy_growth`); 7: the structure's bound on the coupling step
-/// (`BrokerState::dt_structure`); 8: the positions a WCSPH fluid's Verlet candidates were gathered at (in `sph.bin`).
-pub const FORMAT: u32 = 8;
+/// (`BrokerState::dt_structure`); 8: the positions a WCSPH fluid's Verlet candidates were gathered at (in `sph.bin`);
+/// 9: the energy balance's rounding (`EnergyGrowth::rounding`).
+pub const FORMAT: u32 = 9;
 /// The manifest's file name.
 pub const MANIFEST: &str = "checkpoint.json";
 const TAG: &str = "cosim-broker-checkpoint";

@@ -69,25 +69,40 @@ pub struct EnergyGrowth {
     /// WCSPH, its elastic energy Σ m e(ρ) (`sph_node::eos::Tait::specific_energy`), plus the structure's kinetic,
     /// strain and gravitational energy (the `energy` probes count all of these but the elastic energy).
     pub initial: f64,
+    /// How far rounding could move the energy of an output time, at most, as a fraction of
+    /// [`EnergyGrowth::budget`] ([`crate::probes::Probes::energy_rounding`]): a gain within the rounding of the two
+    /// energies it compares is not counted. Some 1e-12 on the shipped scenes; where a structure's own energies are
+    /// 1e15 times the water's (a solid of ρ = 1e20 falling under its weight), past 1, and the balance cannot see a
+    /// gain of the budget's size.
+    #[serde(default)]
+    pub rounding: f64,
 }
 
 impl EnergyGrowth {
-    /// The balance of a run whose first output time holds `energy`, with `budget` ([`releasable`]); `None` where
-    /// there is no budget to measure a gain against (no fluid, no gravity).
-    pub fn start(t: f64, energy: f64, budget: f64) -> Option<Self> {
-        (budget > 0.0 && budget.is_finite() && energy.is_finite()).then_some(Self {
+    /// The balance of a run whose first output time holds `energy`, up to `rounding` [J/m], with `budget`
+    /// ([`releasable`]); `None` where there is no budget to measure a gain against (no fluid, no gravity).
+    pub fn start(t: f64, energy: f64, rounding: f64, budget: f64) -> Option<Self> {
+        (budget > 0.0 && budget.is_finite() && energy.is_finite() && rounding.is_finite()).then_some(Self {
             largest: 0.0,
             at: t,
             budget,
             initial: energy,
+            rounding: rounding / budget,
         })
     }
 
-    /// Take the energy of output time `t`; true at the first output time whose gain passes [`WARN_GROWTH`]. A
-    /// non-finite energy (a state blowing up, which the nodes refuse) is skipped.
-    pub fn observe(&mut self, t: f64, energy: f64) -> bool {
+    /// Take the energy of output time `t`, up to `rounding` [J/m]; true at the first output time whose gain passes
+    /// [`WARN_GROWTH`]. A non-finite energy (a state blowing up, which the nodes refuse) is skipped, and so is a
+    /// gain within the rounding of the two energies it compares (the start's is within
+    /// [`EnergyGrowth::rounding`]).
+    pub fn observe(&mut self, t: f64, energy: f64, rounding: f64) -> bool {
+        if !(energy.is_finite() && rounding.is_finite()) {
+            return false;
+        }
+        let floor = rounding / self.budget + self.rounding;
+        self.rounding = self.rounding.max(rounding / self.budget);
         let gain = (energy - self.initial) / self.budget;
-        if !(energy.is_finite() && gain > self.largest) {
+        if !(gain > self.largest && gain > floor) {
             return false;
         }
         let crossed = !made_energy(self.largest) && made_energy(gain);
@@ -110,6 +125,12 @@ pub fn elastic_eos(scene: &Scene) -> Option<Tait> {
 /// release of the hydrostatic compression a WCSPH column starts with as one.
 pub fn elastic_energy(eos: &Tait, m: &[f64], rho: &[f64]) -> f64 {
     m.iter().zip(rho).map(|(m, rho)| m * eos.specific_energy(*rho)).sum()
+}
+
+/// The size the elastic energy's terms are computed at [J/m]: e(ρ) is a difference of terms of order B/ρ0 (1/ρ
+/// and (ρ/ρ0)⁶/6, against 1 + 1/6), so each m e(ρ) is off by a few u m B/ρ0, not u m e(ρ): Σ 3 m B/ρ0.
+pub fn elastic_size(eos: &Tait, m: &[f64]) -> f64 {
+    3.0 * eos.b() / eos.rho0 * m.iter().map(|m| m.abs()).sum::<f64>()
 }
 
 /// The potential energy particles of masses `m` at `x` release under `gravity` falling to the height of the lowest
@@ -156,30 +177,51 @@ mod tests {
 
     #[test]
     fn no_budget_no_balance() {
-        assert_eq!(EnergyGrowth::start(0.0, 1.0, 0.0), None);
-        assert_eq!(EnergyGrowth::start(0.0, f64::NAN, 2.0), None);
-        assert!(EnergyGrowth::start(0.0, -3.0, 2.0).is_some());
+        assert_eq!(EnergyGrowth::start(0.0, 1.0, 0.0, 0.0), None);
+        assert_eq!(EnergyGrowth::start(0.0, f64::NAN, 0.0, 2.0), None);
+        assert_eq!(EnergyGrowth::start(0.0, 1.0, f64::INFINITY, 2.0), None);
+        assert!(EnergyGrowth::start(0.0, -3.0, 0.0, 2.0).is_some());
     }
 
     #[test]
     fn the_largest_gain_is_kept_and_the_warning_given_once() {
         // Numbers exact in binary: a budget of 16 J/m from −4 J/m.
-        let mut g = EnergyGrowth::start(0.0, -4.0, 16.0).unwrap();
+        let mut g = EnergyGrowth::start(0.0, -4.0, 0.0, 16.0).unwrap();
         // Losses leave the largest gain at the start's 0.
-        assert!(!g.observe(0.1, -5.0));
+        assert!(!g.observe(0.1, -5.0, 0.0));
         assert_eq!((g.largest, g.at), (0.0, 0.0));
         // A gain of 1/16 of the budget is under the line.
-        assert!(!g.observe(0.2, -3.0));
+        assert!(!g.observe(0.2, -3.0, 0.0));
         assert_eq!((g.largest, g.at), (0.0625, 0.2));
         // Past it: warned once, at the first output time past it.
-        assert!(g.observe(0.3, -2.0));
+        assert!(g.observe(0.3, -2.0, 0.0));
         assert_eq!((g.largest, g.at), (0.125, 0.3));
-        assert!(!g.observe(0.4, 0.0));
+        assert!(!g.observe(0.4, 0.0, 0.0));
         assert_eq!((g.largest, g.at), (0.25, 0.4));
         // Smaller gains, and non-finite energies, leave it.
-        assert!(!g.observe(0.5, -1.0));
-        assert!(!g.observe(0.6, f64::NAN));
-        assert!(!g.observe(0.7, f64::INFINITY));
+        assert!(!g.observe(0.5, -1.0, 0.0));
+        assert!(!g.observe(0.6, f64::NAN, 0.0));
+        assert!(!g.observe(0.7, f64::INFINITY, 0.0));
         assert_eq!((g.largest, g.at), (0.25, 0.4));
+    }
+
+    #[test]
+    fn a_gain_within_the_energies_rounding_is_not_counted() {
+        // A budget of 16 J/m from 0, the start's energy good to 0.5 J/m.
+        let mut g = EnergyGrowth::start(0.0, 0.0, 0.5, 16.0).unwrap();
+        assert_eq!(g.rounding, 0.5 / 16.0);
+        // 4 J/m (0.25 of the budget) where the two energies compared are good to 3.5 and 0.5 J/m: rounding.
+        assert!(!g.observe(0.1, 4.0, 3.5));
+        assert_eq!((g.largest, g.at), (0.0, 0.0));
+        // The largest rounding of an output time so far is kept, and stands for the start's from then on.
+        assert_eq!(g.rounding, 3.5 / 16.0);
+        assert!(!g.observe(0.2, 4.5, 1.0));
+        assert_eq!((g.largest, g.rounding), (0.0, 3.5 / 16.0));
+        // Past both: counted, and warned.
+        assert!(g.observe(0.3, 8.0, 1.0));
+        assert_eq!((g.largest, g.at), (0.5, 0.3));
+        // A non-finite rounding (a state blowing up) is skipped with its energy.
+        assert!(!g.observe(0.4, 12.0, f64::NAN));
+        assert_eq!((g.largest, g.rounding), (0.5, 3.5 / 16.0));
     }
 }

@@ -243,6 +243,56 @@ impl Probes {
         structure + fluid
     }
 
+    /// How far rounding can move [`Probes::mechanical_energy`] plus the fluid's elastic energy [J/m], to first
+    /// order and at worst; `elastic` is the size the elastic terms are computed at
+    /// ([`crate::energy_balance::elastic_size`]), `steps` the (structure, fluid) steps taken so far. Two parts, the
+    /// unit roundoff u times:
+    /// - the sums: a recursive sum of n terms is off by at most (n − 1) u Σ|x_i| (Higham 2002, Eq. (4.4)). fem-node
+    ///   sends each solid's sums, not their terms: there the sums' magnitudes stand for the terms' (a structure's
+    ///   kinetic and strain terms are ≥ 0, and its nodes' gravitational terms share their sign as it sags or falls);
+    /// - the states: each step's x += Δt v rounds x by up to u|x|, and v by up to u|v|, so after N steps the
+    ///   gravitational energy is off by up to N u Σ m |g·x| (the heights from the origin, not from the start: a
+    ///   body far from the origin has coarser positions) and the kinetic energy by up to 2 N u Σ m v²/2.
+    pub fn energy_rounding(
+        &self,
+        fem: Option<(&FemMesh, &FemSnapshot)>,
+        sph: Option<(&SphSetup, &SphSnapshot)>,
+        elastic: f64,
+        steps: (u64, u64),
+    ) -> f64 {
+        let u = 0.5 * f64::EPSILON;
+        let g = self.gravity;
+        let heights = |m: &[f64], x: &[[f64; 2]]| -> f64 {
+            m.iter()
+                .zip(x)
+                .map(|(m, x)| (m * (g[0] * x[0] + g[1] * x[1])).abs())
+                .sum()
+        };
+        let structure = fem.map_or(0.0, |(mesh, snap)| {
+            let terms = (mesh.nodes.len() + mesh.cell_solid.len()) as f64;
+            let (mut kinetic, mut sums) = (0.0, 0.0);
+            for e in &snap.energies {
+                kinetic += e.kinetic.abs();
+                sums += e.kinetic.abs() + e.strain.abs() + e.potential.abs();
+            }
+            let states = (steps.0 + 1) as f64 * (heights(&mesh.masses, &snap.x) + 2.0 * kinetic);
+            terms * sums + states
+        });
+        let fluid = sph.map_or(0.0, |(_, snap)| {
+            let potential = self.fluid_x0.as_ref().map_or(0.0, |x0| {
+                snap.m
+                    .iter()
+                    .zip(snap.x.iter().zip(x0))
+                    .map(|(m, (x, x0))| (m * (g[0] * (x[0] - x0[0]) + g[1] * (x[1] - x0[1]))).abs())
+                    .sum::<f64>()
+            });
+            let kinetic = self.fluid_energy(snap, EnergyPart::Kinetic);
+            let states = (steps.1 + 1) as f64 * (heights(&snap.m, &snap.x) + 2.0 * kinetic);
+            snap.m.len() as f64 * (kinetic + potential + elastic) + states
+        });
+        u * (structure + fluid)
+    }
+
     /// Gravity, as the scene gives it.
     pub fn gravity(&self) -> [f64; 2] {
         self.gravity

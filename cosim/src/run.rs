@@ -167,6 +167,17 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         if let Some(why) = summary.trace.as_ref().and_then(|t| t.stopped.as_ref()) {
             eprintln!("cosim: warning: the trace holds the run only in part: the recording stopped {why}");
         }
+        // A balance that cannot see a gain of the warning's size: the energies it sums are too large beside the
+        // water's (`EnergyGrowth::rounding`).
+        if let Some(g) = summary.energy_growth.as_ref().filter(|g| made_energy(g.rounding)) {
+            eprintln!(
+                "cosim: note: the energy balance cannot see a gain under {:.1} % of the {:.4} J/m the water can \
+                 release: the energies it sums are so large beside it that rounding alone can move their balance that \
+                 much (summary.json energy_growth.rounding)",
+                cosim_proto::Num(200.0 * g.rounding),
+                cosim_proto::Num(g.budget)
+            );
+        }
         // Ok, but not to be trusted without a look: energy the scheme made (`contact_broker::energy_balance`).
         if let Some(g) = summary.energy_growth.as_ref().filter(|g| made_energy(g.largest)) {
             eprintln!(

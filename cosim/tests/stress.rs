@@ -785,3 +785,54 @@ fn assert_isph_gate(max_dt: &str) {
     let energy = assert_energy(&case, &out, budget, releasable);
     report(&case, &out, energy);
 }
+
+/// A solid so heavy that its own energies dwarf the water's is not read as making energy: the gate at ρ = 1e20
+/// kg/m³ falls under its weight (its wave speed is 3.5e-7 m/s), trading ~1e14 J/m of gravitational for kinetic
+/// energy by t = 0.01 s, and the sum of the two moved by ~9 J/m of rounding (multiples of 1/32 J/m, the spacing of
+/// doubles there), 0.16 of the water's 9.48 J/m budget: before the balance counted its rounding
+/// (`Probes::energy_rounding`), the run ended with the warning that the scheme had made energy. Now the gain is
+/// within the rounding, the summary says how large that is (`energy_growth.rounding`, 24 of the budget measured
+/// 2026-12-06), and `cosim run` notes that the balance cannot see a gain under twice it. At the scene's density
+/// (1100) the rounding is ~1e-10 of the budget, the balance as before.
+#[test]
+fn a_falling_solid_heavier_than_the_water_by_1e17_makes_no_energy() {
+    let sets = |rho: &str| -> Vec<String> {
+        [
+            "run.end_time=0.01",
+            "run.output_interval=0.001",
+            &format!("solid[0].material.density={rho}"),
+        ]
+        .map(String::from)
+        .into()
+    };
+    let heavy = run("heavy-gate", "scenes/elastic_gate.toml", &sets("1e20"));
+    heavy.assert_ok_and_finite("gate at ρ_s = 1e20");
+    let g = &heavy.summary["energy_growth"];
+    let (largest, rounding) = (g["largest"].as_f64(), g["rounding"].as_f64());
+    let (Some(largest), Some(rounding)) = (largest, rounding) else {
+        panic!("gate at ρ_s = 1e20: energy_growth {g}")
+    };
+    assert!(
+        largest <= WARN_GROWTH,
+        "gate at ρ_s = 1e20: a gain of {largest} of the budget; {g}"
+    );
+    assert!(
+        rounding > WARN_GROWTH,
+        "gate at ρ_s = 1e20: rounding {rounding} of the budget; {g}"
+    );
+    assert!(!heavy.stderr.contains("cosim: warning"), "{}", heavy.stderr);
+    assert!(
+        heavy
+            .stderr
+            .contains("cosim: note: the energy balance cannot see a gain under"),
+        "{}",
+        heavy.stderr
+    );
+    let shipped = run("shipped-gate", "scenes/elastic_gate.toml", &sets("1100"));
+    shipped.assert_ok_and_finite("gate at ρ_s = 1100");
+    let rounding = shipped.summary["energy_growth"]["rounding"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    assert!(rounding < 1e-9, "gate at ρ_s = 1100: rounding {rounding} of the budget");
+    assert!(!shipped.stderr.contains("cosim: note"), "{}", shipped.stderr);
+}

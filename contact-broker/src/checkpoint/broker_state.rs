@@ -96,8 +96,16 @@ impl BrokerState {
         if let Some(g) = &s.energy_growth {
             // A budget that is not positive would divide every later gain by zero or turn its sign.
             ensure(
-                g.budget > 0.0 && g.budget.is_finite() && finite(&[g.initial, g.largest, g.at]) && g.largest >= 0.0,
-                || format!("summary.energy_growth = {g:?} is not a balance (budget > 0, gain ≥ 0, all finite)"),
+                g.budget > 0.0
+                    && g.budget.is_finite()
+                    && finite(&[g.initial, g.largest, g.at, g.rounding])
+                    && g.largest >= 0.0
+                    && g.rounding >= 0.0,
+                || {
+                    format!(
+                        "summary.energy_growth = {g:?} is not a balance (budget > 0, gain and rounding ≥ 0, all finite)"
+                    )
+                },
             )?;
         }
         let interval = scene.run.output_interval;
@@ -397,27 +405,30 @@ component = "x"
 
     #[test]
     fn an_energy_balance_without_a_budget_is_refused() {
-        let growth = |budget: f64, largest: f64| {
+        let growth = |budget: f64, largest: f64, rounding: f64| {
             refused(|s| {
                 s.summary.energy_growth = Some(crate::energy_balance::EnergyGrowth {
                     largest,
                     at: 0.1,
                     budget,
                     initial: -1.0,
+                    rounding,
                 })
             })
         };
-        for (budget, largest) in [
-            (0.0, 0.1),
-            (-2.0, 0.1),
-            (f64::NAN, 0.1),
-            (2.0, f64::INFINITY),
-            (2.0, -0.5),
+        for (budget, largest, rounding) in [
+            (0.0, 0.1, 0.0),
+            (-2.0, 0.1, 0.0),
+            (f64::NAN, 0.1, 0.0),
+            (2.0, f64::INFINITY, 0.0),
+            (2.0, -0.5, 0.0),
+            (2.0, 0.1, -1e-12),
+            (2.0, 0.1, f64::NAN),
         ] {
-            let e = growth(budget, largest);
+            let e = growth(budget, largest, rounding);
             assert!(e.starts_with("summary.energy_growth = "), "{e}");
             assert!(
-                e.ends_with("is not a balance (budget > 0, gain ≥ 0, all finite)"),
+                e.ends_with("is not a balance (budget > 0, gain and rounding ≥ 0, all finite)"),
                 "{e}"
             );
         }

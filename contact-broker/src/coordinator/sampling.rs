@@ -15,7 +15,7 @@ use sph_node::eos::Tait;
 use super::exchange::Round;
 use super::inputs::Nodes;
 use crate::checkpoint::BrokerState;
-use crate::energy_balance::{elastic_energy, elastic_eos, releasable, shorter_step, EnergyGrowth};
+use crate::energy_balance::{elastic_energy, elastic_eos, elastic_size, releasable, shorter_step, EnergyGrowth};
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
@@ -164,16 +164,18 @@ fn energy_balance(
     sph: Option<(&SphSetup, &SphSnapshot)>,
     summary: &mut Summary,
 ) {
-    let elastic = match (eos, sph) {
-        (Some(eos), Some((_, s))) => elastic_energy(eos, &s.m, &s.rho),
-        _ => 0.0,
+    let (elastic, elastic_size) = match (eos, sph) {
+        (Some(eos), Some((_, s))) => (elastic_energy(eos, &s.m, &s.rho), elastic_size(eos, &s.m)),
+        _ => (0.0, 0.0),
     };
     let energy = probes.mechanical_energy(fem, sph) + elastic;
+    let steps = (summary.fem_substeps, summary.sph_substeps);
+    let rounding = probes.energy_rounding(fem, sph, elastic_size, steps);
     if index == 0 {
         let budget = sph.map_or(0.0, |(_, s)| releasable(&s.m, &s.x, probes.gravity()));
-        summary.energy_growth = EnergyGrowth::start(t, energy, budget);
+        summary.energy_growth = EnergyGrowth::start(t, energy, rounding, budget);
     } else if let Some(growth) = summary.energy_growth.as_mut() {
-        if growth.observe(t, energy) {
+        if growth.observe(t, energy, rounding) {
             // The step to try, from the steps so far (`cosim run` names it again after the run, from all of them).
             let hint = shorter_step(summary.sim_time, summary.steps).map_or(String::new(), |h| {
                 format!(
