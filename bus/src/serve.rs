@@ -83,12 +83,32 @@ pub trait NodeCore {
         None
     }
 
+    /// The simulated time the node's state has reached [s]; `None` for a node that does not keep one.
+    fn time(&self) -> Option<f64> {
+        None
+    }
+
     /// Continue from the bytes [`NodeCore::checkpoint`] gave, on a node built from the same scene.
     fn restore(&mut self, _data: &[u8]) -> Result<(), Failure> {
         Err(Failure {
             unstable: false,
             message: "this node cannot continue from a checkpoint".into(),
         })
+    }
+}
+
+/// A restored state must be at the checkpoint's time, `t` [s]: within a millionth of `coupling.max_dt` (a node's
+/// time sums its own steps, the broker's lands on the output times, so they differ in their last bits). A state
+/// saved at another time continued from the wrong place and ended `ok` (found 2026-12-06: `broker.bin` shifted from
+/// t = 0.01 to 0.0149 s with its checksum rewritten ran 0.0049 s short and said it reached its end).
+pub fn check_restored_time(node: Option<f64>, t: f64, max_dt: f64) -> anyhow::Result<()> {
+    match node {
+        Some(node) if (node - t).abs() > 1e-6 * max_dt || node.is_nan() => anyhow::bail!(
+            "cannot restart from the checkpoint: its state is at t = {} s, the checkpoint at t = {} s",
+            cosim_proto::Num(node),
+            cosim_proto::Num(t)
+        ),
+        _ => Ok(()),
     }
 }
 
@@ -204,6 +224,7 @@ fn serve_session<C: NodeCore>(
     if let Some(saved) = fetch_restore(session, run, topics, timeout)? {
         core.restore(&saved.body.data)
             .map_err(|e| anyhow::anyhow!("cannot restart from the checkpoint: {e}"))?;
+        check_restored_time(core.time(), saved.t, scene.coupling.max_dt)?;
         expected = saved.step + 1;
         t = saved.t;
         board.update(|s| {

@@ -402,6 +402,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                         .and_then(|e| e.expect_step(step, self.topics.state))
                     {
                         Ok(env) => {
+                            // A failure the node reported before this answer ends the run: a node that says
+                            // `unstable` and keeps answering must not end `ok` (docs/PROTOCOL.md §7).
+                            while let Ok(Some(sample)) = self.error.try_recv() {
+                                if let Some(e) = self.node_error(&sample) {
+                                    return Err(e);
+                                }
+                            }
                             if let Some(tap) = &self.tap {
                                 tap.record(Kind::State, step, &bytes);
                             }

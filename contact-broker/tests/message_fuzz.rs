@@ -61,6 +61,7 @@ enum MeshSpoil {
     DtStable(f64),
     NoNodes,
     NoSolids,
+    NoInterface,
     HugeCellSolid(usize),
 }
 
@@ -81,6 +82,7 @@ enum FemSpoil {
 enum SetupSpoil {
     Spacing(f64),
     H(f64),
+    Density(f64),
     Wall(usize, f64),
     DtStable(f64),
 }
@@ -99,8 +101,15 @@ enum SphSpoil {
     HugeIds(usize),
 }
 
+/// Not a number a state can hold: NaN, ±∞, or finite beyond ±1e50 (`cosim_proto::validate::LARGEST`).
 fn bad_number() -> impl Strategy<Value = f64> {
-    prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)]
+    prop_oneof![
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        Just(1e200),
+        Just(-1e308)
+    ]
 }
 
 fn not_positive() -> impl Strategy<Value = f64> {
@@ -117,7 +126,7 @@ fn spoils() -> impl Strategy<Value = Spoil> {
     let mesh = prop_oneof![
         (any::<usize>(), any::<u32>()).prop_map(|(i, v)| MeshSpoil::SegmentEnd(i, v)),
         (1usize..50).prop_map(MeshSpoil::FewerMasses),
-        (any::<usize>(), not_positive()).prop_map(|(i, v)| MeshSpoil::Mass(i, v)),
+        (any::<usize>(), prop_oneof![not_positive(), Just(1.7e308)]).prop_map(|(i, v)| MeshSpoil::Mass(i, v)),
         (any::<usize>(), bad_number()).prop_map(|(i, v)| MeshSpoil::Node(i, v)),
         (any::<usize>(), 1u32..).prop_map(|(i, v)| MeshSpoil::NodeSolid(i, v)),
         (any::<usize>(), any::<u32>()).prop_map(|(i, v)| MeshSpoil::CellNode(i, v)),
@@ -126,6 +135,7 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         not_positive().prop_map(MeshSpoil::DtStable),
         Just(MeshSpoil::NoNodes),
         Just(MeshSpoil::NoSolids),
+        Just(MeshSpoil::NoInterface),
         (1usize..200_000).prop_map(MeshSpoil::HugeCellSolid),
     ];
     let fem = prop_oneof![
@@ -137,11 +147,14 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         Just(FemSpoil::StressShort),
         Just(FemSpoil::NoSnapshot),
         not_positive().prop_map(FemSpoil::DtStable),
-        prop_oneof![Just(f64::NAN), Just(-1.0)].prop_map(FemSpoil::Seconds),
+        prop_oneof![Just(f64::NAN), Just(-1.0), Just(1.7e308)].prop_map(FemSpoil::Seconds),
     ];
     let setup = prop_oneof![
-        not_positive().prop_map(SetupSpoil::Spacing),
-        not_positive().prop_map(SetupSpoil::H),
+        // Positive but not the scene's: a spacing of 1e-300 made `particle_particle` build 1e300 points a segment,
+        // and one of 0.2 ran `ok` with no contact.
+        prop_oneof![not_positive(), Just(1e-300), Just(0.2)].prop_map(SetupSpoil::Spacing),
+        prop_oneof![not_positive(), Just(0.5)].prop_map(SetupSpoil::H),
+        prop_oneof![Just(1.0), Just(1e6)].prop_map(SetupSpoil::Density),
         (any::<usize>(), bad_number()).prop_map(|(i, v)| SetupSpoil::Wall(i, v)),
         prop_oneof![Just(0.0), Just(-1e-4), Just(f64::NAN)].prop_map(SetupSpoil::DtStable),
     ];
@@ -223,6 +236,12 @@ fn spoil_mesh(m: &mut FemMesh, how: &MeshSpoil) -> &'static str {
             m.solid_names.clear();
             "solid_names"
         }
+        MeshSpoil::NoInterface => {
+            // A coupled structure with no surface made an infinite region of interest, refused by the fluid node
+            // as the broker's fault.
+            m.interface.clear();
+            "interface"
+        }
         MeshSpoil::HugeCellSolid(k) => {
             m.cell_solid.extend(std::iter::repeat_n(0, k));
             "cell_solid"
@@ -280,6 +299,10 @@ fn spoil_setup(s: &mut SphSetup, how: &SetupSpoil) -> &'static str {
         SetupSpoil::H(v) => {
             s.h = v;
             "h"
+        }
+        SetupSpoil::Density(v) => {
+            s.density = v;
+            "density"
         }
         SetupSpoil::Wall(i, v) => {
             let k = pick(i, s.walls.len());
@@ -431,6 +454,87 @@ proptest! {
             }
         }
     }
+}
+
+/// The cases of the 2026-12-06 sweep of hostile external nodes, each of which ran on (`ok`, hung, or filled the
+/// memory) before, drawn every time rather than when the fuzz's seed happens to: registrations that disagree with
+/// the scene, a coupled structure without a surface, finite numbers beyond any state (a structure at 1e308 m or
+/// 1e200 m/s, a mass of 1.7e308 kg/m) and seconds of computation that overflow the run's timings.
+#[test]
+fn the_sweeps_cases_are_refused_naming_their_field() {
+    let cases = [
+        (
+            Spoil::Setup(SetupSpoil::Spacing(1e-300)),
+            "sph/setup spacing = 1e-300: the scene gives 0.1",
+        ),
+        (
+            Spoil::Setup(SetupSpoil::Spacing(0.2)),
+            "sph/setup spacing = 0.2: the scene gives 0.1",
+        ),
+        (
+            Spoil::Setup(SetupSpoil::H(0.5)),
+            "sph/setup h = 0.5: the scene gives 0.13",
+        ),
+        (
+            Spoil::Setup(SetupSpoil::Density(1e6)),
+            "sph/setup density = 1000000: the scene gives 1000",
+        ),
+        (Spoil::Mesh(MeshSpoil::NoInterface), "fem/mesh interface = 0 entries"),
+        (
+            Spoil::Mesh(MeshSpoil::Mass(0, 1.7e308)),
+            "fem/mesh masses[0] = 1.7e308: must be a number > 0 and ≤ 1e50",
+        ),
+        (
+            Spoil::Fem {
+                step: 3,
+                how: FemSpoil::X(0, -1e308),
+            },
+            "fem/state x[0][0] = -1e308: not a finite number within ±1e50",
+        ),
+        (
+            Spoil::Fem {
+                step: 3,
+                how: FemSpoil::Seconds(1.7e308),
+            },
+            "fem/state compute_seconds = 1.7e308: must be a number of seconds within 0…1e9",
+        ),
+    ];
+    for (spoil, want) in cases {
+        let (status, message, _) = run_spoilt(&spoil);
+        assert_ne!(status, RunStatus::Ok, "{spoil:?}: {message}");
+        assert!(message.contains(want), "{spoil:?}: `{want}` not in `{message}`");
+    }
+}
+
+/// A stable step that collapses (found 2026-12-06 by a sweep of hostile external nodes: a fluid node reporting
+/// `dt_stable = 1e-300` every step held the run at a frozen time, 79,000 steps in 30 s, until it was killed; a
+/// restored contact bound of 1e-300 s the same) ends the run `unstable` at once, naming the node and the value. One
+/// such answer is enough: before, that step was taken and the run went on `ok`.
+#[test]
+fn a_collapsing_stable_step_ends_the_run_unstable_naming_the_node() {
+    for (step, dt) in [(2, 1e-300), (5, 1e-20)] {
+        let spoil = Spoil::Sph {
+            step,
+            how: SphSpoil::DtStable(dt),
+        };
+        let (status, message, _) = run_spoilt(&spoil);
+        assert_eq!(status, RunStatus::Unstable, "{dt}: {message}");
+        assert!(
+            message.starts_with("sph-node: the coupling step collapsed to"),
+            "{message}"
+        );
+        assert!(
+            message.contains(&format!("sph/state dt_stable = {dt:e} s")),
+            "{message}"
+        );
+    }
+    // A short step that still moves the run on is taken: 1e-12 s against coupling.max_dt / 2^32 = 2.3e-14 s.
+    let spoil = Spoil::Sph {
+        step: 2,
+        how: SphSpoil::DtStable(1e-12),
+    };
+    let (status, message, _) = run_spoilt(&spoil);
+    assert_eq!(status, RunStatus::Ok, "{message}");
 }
 
 /// A command the node cannot use: `(what it spoils, the field named)`.

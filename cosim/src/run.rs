@@ -11,6 +11,7 @@ use contact_broker::recorder::{Recorded, Recorder, Tap};
 use contact_broker::setup::RunSetup;
 use contact_broker::summary::{self, Summary};
 use cosim_bus::interrupt::Interrupt;
+use cosim_bus::serve::{check_restored_time, NodeCore};
 use cosim_proto::keys::{fresh_run_id, valid_run_id};
 use cosim_proto::scene::{LoadedScene, STRUCTURE_COURANT_DEFAULT, STRUCTURE_COURANT_MIN};
 use cosim_proto::sizing::Part;
@@ -296,6 +297,8 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
             if let Some(data) = setup.saved_fem() {
                 core.restore(data)
                     .context("fem-node: cannot restart from the checkpoint")?;
+                let t = NodeCore::time(&core);
+                check_restored_time(t, setup.restart_time(), scene.scene.coupling.max_dt).context("fem-node")?;
             }
             Some(core)
         }
@@ -307,6 +310,8 @@ fn run_in_process(args: &RunArgs, setup: &RunSetup, info: &RunInfo, bar: &Bar) -
             if let Some(data) = setup.saved_sph() {
                 core.restore(data)
                     .context("sph-node: cannot restart from the checkpoint")?;
+                let t = NodeCore::time(&core);
+                check_restored_time(t, setup.restart_time(), scene.scene.coupling.max_dt).context("sph-node")?;
             }
             Some(core)
         }

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use common::*;
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic};
-use cosim_proto::messages::FemMesh;
+use cosim_proto::messages::{FemMesh, NodeError, StepCommand};
 use fem_node::core::FemCore;
 use zenoh::Wait;
 
@@ -26,9 +26,17 @@ const SETS: [&str; 6] = [
     "run.end_time=0.001",
 ];
 
-/// Run the coarse hydrostatic plate with an outside structure node that registers `spoil(mesh)`; the run's exit
-/// status, its summary and the broker's log.
-fn run_with_mesh(name: &str, spoil: impl Fn(&mut FemMesh)) -> (std::process::ExitStatus, serde_json::Value, String) {
+/// The coarse hydrostatic plate with an outside structure node: `cosim run` waiting for it, and where to join.
+struct Outside {
+    run: Kill,
+    out: std::path::PathBuf,
+    id: String,
+    endpoint: String,
+    started: Instant,
+    scene: cosim_proto::scene::LoadedScene,
+}
+
+fn outside(name: &str) -> Outside {
     let dir = scratch(name);
     let out = dir.join("out");
     let id = run_id(name);
@@ -76,26 +84,52 @@ fn run_with_mesh(name: &str, spoil: impl Fn(&mut FemMesh)) -> (std::process::Exi
             .collect::<Vec<_>>(),
     )
     .unwrap();
-    let mut mesh = FemCore::new(&scene.scene).unwrap().mesh().clone();
+    Outside {
+        run,
+        out,
+        id,
+        endpoint,
+        started,
+        scene,
+    }
+}
+
+impl Outside {
+    /// The run's exit status, its summary and the broker's log, once it ended.
+    fn ended(mut self, status: std::process::ExitStatus) -> (std::process::ExitStatus, serde_json::Value, String) {
+        let _ = self.run.0.wait();
+        let log = std::fs::read_to_string(self.out.join("logs/contact-broker.log")).unwrap_or_default();
+        (status, json(&self.out.join("summary.json")), log)
+    }
+}
+
+/// Run the coarse hydrostatic plate with an outside structure node that registers `spoil(mesh)`; the run's exit
+/// status, its summary and the broker's log.
+fn run_with_mesh(name: &str, spoil: impl Fn(&mut FemMesh)) -> (std::process::ExitStatus, serde_json::Value, String) {
+    let mut o = outside(name);
+    let mut mesh = FemCore::new(&o.scene.scene).unwrap().mesh().clone();
     spoil(&mut mesh);
-    let bytes = Envelope::new(&id, 0, 0.0, mesh).encode();
-    let (session, _) =
-        cosim_bus::session::open_listening(&["tcp/127.0.0.1:0".to_string()], &[endpoint], 5000).expect("join the run");
+    let bytes = Envelope::new(&o.id, 0, 0.0, mesh).encode();
+    let (session, _) = cosim_bus::session::open_listening(
+        &["tcp/127.0.0.1:0".to_string()],
+        std::slice::from_ref(&o.endpoint),
+        5000,
+    )
+    .expect("join the run");
     // Registered once it arrives; sent again until the run ends, in case the first put beat the connection.
     let status = loop {
-        session.put(key(&id, topic::FEM_MESH), bytes.clone()).wait().unwrap();
-        if let Some(status) = run.0.try_wait().unwrap() {
+        session.put(key(&o.id, topic::FEM_MESH), bytes.clone()).wait().unwrap();
+        if let Some(status) = o.run.0.try_wait().unwrap() {
             break status;
         }
         assert!(
-            started.elapsed() < LIMIT,
+            o.started.elapsed() < LIMIT,
             "the run did not end after an unusable registration"
         );
         std::thread::sleep(Duration::from_millis(200));
     };
     drop(session);
-    let log = std::fs::read_to_string(out.join("logs/contact-broker.log")).unwrap_or_default();
-    (status, json(&out.join("summary.json")), log)
+    o.ended(status)
 }
 
 #[test]
@@ -121,4 +155,77 @@ fn an_unusable_mesh_from_an_outside_node_fails_the_run_naming_the_field() {
         assert!(message.contains(want), "{name}: `{want}` not in `{message}`");
         assert!(!log.contains("panicked"), "{name}: the broker panicked: {log}");
     }
+}
+
+/// An outside structure node that reports itself `unstable` on its error topic and then goes on answering, as a
+/// node whose watchdog fires on another thread would (found 2026-12-06 by a sweep of hostile external nodes): the run
+/// ended `ok`, exit 0, because the broker read the node's error topic only while it waited for an answer that did
+/// not come. Now a failure reported before an answer ends the run with it, naming the node and its message.
+#[test]
+fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
+    let o = outside("bad_messages_error_then_answers");
+    let mut core = FemCore::new(&o.scene.scene).unwrap();
+    let mesh = Envelope::new(&o.id, 0, 0.0, core.mesh().clone()).encode();
+    let (session, _) = cosim_bus::session::open_listening(
+        &["tcp/127.0.0.1:0".to_string()],
+        std::slice::from_ref(&o.endpoint),
+        5000,
+    )
+    .expect("join the run");
+    let _token = session
+        .liveliness()
+        .declare_token(key(&o.id, topic::FEM_ALIVE))
+        .wait()
+        .unwrap();
+    let commands = session
+        .declare_subscriber(key(&o.id, topic::BROKER_FEM))
+        .wait()
+        .unwrap();
+    let mut run = o;
+    let mut registered = false;
+    let status = loop {
+        if let Some(status) = run.run.0.try_wait().unwrap() {
+            break status;
+        }
+        assert!(
+            run.started.elapsed() < LIMIT,
+            "the run did not end after the node's failure"
+        );
+        if !registered {
+            session.put(key(&run.id, topic::FEM_MESH), mesh.clone()).wait().unwrap();
+        }
+        let Ok(Some(sample)) = commands.recv_timeout(Duration::from_millis(200)) else {
+            continue;
+        };
+        registered = true;
+        let bytes = sample.payload().to_bytes();
+        let Ok(cmd) = Envelope::<StepCommand>::decode(&bytes, &run.id, topic::BROKER_FEM) else {
+            continue;
+        };
+        let (step, t) = (cmd.step, cmd.t);
+        if step == 2 {
+            let report = NodeError {
+                status: "unstable".into(),
+                message: "the outside node's own check failed".into(),
+            };
+            let bytes = Envelope::new(&run.id, step, t, report).encode();
+            session.put(key(&run.id, topic::FEM_ERROR), bytes).wait().unwrap();
+        }
+        if let Ok(Some(state)) = core.handle(&cmd.body) {
+            let bytes = Envelope::new(&run.id, step, t, state).encode();
+            session.put(key(&run.id, topic::FEM_STATE), bytes).wait().unwrap();
+        }
+    };
+    drop(commands);
+    drop(session);
+    let (status, summary, _) = run.ended(status);
+    assert_eq!(status.code(), Some(1), "{summary}");
+    assert_eq!(summary["status"], "unstable", "{summary}");
+    let message = summary["message"].as_str().unwrap();
+    assert!(
+        message.contains("fem-node") && message.contains("the outside node's own check failed"),
+        "{message}"
+    );
+    let steps = summary["steps"].as_u64().unwrap();
+    assert!(steps < 10, "the run went on to its end: {steps} steps");
 }

@@ -242,3 +242,50 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
     assert_eq!(got.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("sph-node") && stderr.contains(&why), "{stderr}");
 }
+
+/// A `broker.bin` and manifest whose time was moved (0.01 → 0.0149 s), the checksum rewritten: the nodes' states are
+/// at 0.01 s.
+/// Found 2026-12-06 by a sweep of crafted checkpoints: the run continued from the wrong time and ended `ok`, "reached
+/// t = 0.02 s", having simulated 0.0049 s less. Now each node compares the time its restored state is at with the
+/// checkpoint's, as processes and in one process, and the run fails naming both.
+#[test]
+fn a_checkpoint_whose_times_disagree_is_refused() {
+    let dir = scratch("ck-integrity-time");
+    let ck = first_checkpoint(&dir);
+    let bad = copy_of(&ck, &dir.join("broker-time"));
+    type SavedBroker = (String, u32, BrokerState);
+    let (tag, format, mut state): SavedBroker =
+        bincode::deserialize(&std::fs::read(ck.join("broker.bin")).unwrap()).unwrap();
+    assert!(
+        (state.t - 0.01).abs() < 1e-12,
+        "the first checkpoint at t = {}",
+        state.t
+    );
+    state.t = 0.0149;
+    state.summary.sim_time = 0.0149;
+    rewrite(&bad, "broker.bin", &bincode::serialize(&(tag, format, state)).unwrap());
+    // The manifest with it (it and broker.bin must agree).
+    let path = bad.join("checkpoint.json");
+    let mut manifest = json(&path);
+    manifest["t"] = serde_json::json!(0.0149);
+    std::fs::write(&path, manifest.to_string()).unwrap();
+    for in_process in [false, true] {
+        let out = dir.join(format!("out-{in_process}"));
+        let got = restart(&bad, &out, in_process);
+        let stderr = String::from_utf8_lossy(&got.stderr);
+        assert_ne!(got.status.code(), Some(0), "in process {in_process}: {stderr}");
+        let said = match in_process {
+            true => stderr.to_string(),
+            false => json(&out.join("summary.json"))["message"]
+                .as_str()
+                .unwrap_or_default()
+                .to_string(),
+        };
+        assert!(
+            said.contains(
+                "cannot restart from the checkpoint: its state is at t = 0.01 s, the checkpoint at t = 0.0149 s"
+            ),
+            "in process {in_process}: {said} / {stderr}"
+        );
+    }
+}

@@ -50,6 +50,10 @@ impl NodeCore for FemCore {
         Some(FemCore::checkpoint(self))
     }
 
+    fn time(&self) -> Option<f64> {
+        Some(self.solver().state().t)
+    }
+
     fn restore(&mut self, data: &[u8]) -> Result<(), Failure> {
         FemCore::restore(self, data).map_err(Failure::from)
     }

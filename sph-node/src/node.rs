@@ -50,6 +50,10 @@ impl NodeCore for SphCore {
         Some(SphCore::checkpoint(self))
     }
 
+    fn time(&self) -> Option<f64> {
+        Some(self.solver().state().t)
+    }
+
     fn restore(&mut self, data: &[u8]) -> Result<(), Failure> {
         SphCore::restore(self, data).map_err(Failure::from)
     }

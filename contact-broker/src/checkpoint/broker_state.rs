@@ -142,7 +142,7 @@ impl BrokerState {
         check_corrections("pending_fem", &self.pending_fem, fem_nodes, "structure nodes")?;
         check_corrections("pending_sph", &self.pending_sph, particles, "fluid particles")?;
         if let Some(roi) = self.roi {
-            ensure(!roi.iter().any(|x| x.is_nan()), || format!("roi = {roi:?} holds NaN"))?;
+            ensure(finite(&roi), || format!("roi = {roi:?} is not finite"))?;
         }
         if let Some(load) = &self.load {
             ensure(load.len() as u64 == fem_nodes, || {

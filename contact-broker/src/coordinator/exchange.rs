@@ -6,7 +6,9 @@ use std::time::Instant;
 use anyhow::Context;
 
 use cosim_proto::messages::{FemState, SphState, StepCommand};
+use cosim_proto::scene::Scene;
 use cosim_proto::validate::{Asked, Invalid};
+use cosim_proto::Num;
 
 use super::inputs::Nodes;
 use crate::interface::Corrections;
@@ -19,12 +21,37 @@ pub(super) struct Round {
     pub sph: Option<SphState>,
 }
 
-/// docs/PROTOCOL.md §7 "Contents": the registrations are checked before anything indexes them.
-pub(super) fn check_registrations(nodes: &Nodes<'_>) -> anyhow::Result<()> {
+/// docs/PROTOCOL.md §7 "Contents": the registrations are checked before anything indexes them, and against what
+/// the scene fixes: a coupled structure must have a surface (none made an infinite region of interest, which the
+/// fluid node refused as the broker's fault), and the fluid's spacing, smoothing length and density are the scene's
+/// (the contact's thickness, reach and region of interest are made from them: a fluid node registering 1e-300 m
+/// made `particle_particle` build 1e300 points a segment, and one at twice the spacing ran `ok` with no contact).
+pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::Result<()> {
     if let Some(link) = &nodes.fem {
         link.setup().validate().map_err(|e| unusable("fem-node", e))?;
+        if nodes.sph.is_some() && link.setup().interface.is_empty() {
+            return Err(unusable_because(
+                "fem-node",
+                "fem/mesh interface = 0 entries: a structure coupled to a fluid needs its boundary segments".into(),
+            ));
+        }
     }
-    if let Some(link) = &nodes.sph {
+    if let (Some(link), Some(f)) = (&nodes.sph, &scene.fluid) {
+        let setup = link.setup();
+        setup.validate().map_err(|e| unusable("sph-node", e))?;
+        for (field, got, want) in [
+            ("spacing", setup.spacing, f.spacing),
+            ("h", setup.h, f.smoothing_ratio * f.spacing),
+            ("density", setup.density, f.density),
+        ] {
+            if (got - want).abs() > 1e-9 * want.abs() {
+                return Err(unusable_because(
+                    "sph-node",
+                    format!("sph/setup {field} = {}: the scene gives {}", Num(got), Num(want)),
+                ));
+            }
+        }
+    } else if let Some(link) = &nodes.sph {
         link.setup().validate().map_err(|e| unusable("sph-node", e))?;
     }
     Ok(())
@@ -155,6 +182,15 @@ pub(super) fn farewell(nodes: &mut Nodes<'_>) {
     if let Some(link) = nodes.sph.as_deref_mut() {
         link.farewell();
     }
+}
+
+/// A registration from `node` that disagrees with the scene: the run fails.
+fn unusable_because(node: &str, why: String) -> anyhow::Error {
+    LinkError::Failed {
+        node: node.into(),
+        message: format!("sent an unusable message: {why}"),
+    }
+    .into()
 }
 
 /// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state,

@@ -134,7 +134,7 @@ fn drive(
     mut debugger: Option<&mut Debugger<'_>>,
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
-    check_registrations(nodes)?;
+    check_registrations(s, nodes)?;
     let interface_ids = nodes
         .fem
         .as_ref()
@@ -166,6 +166,7 @@ fn drive(
         while clock.running() {
             // §3 step 1: how long this step is, and whether it lands on an output time.
             let step = clock.next_step();
+            clock.check_step(&step)?;
             // §3 steps 2–3: the commands out (with the last pass's corrections), the states in.
             let commands = contact.commands(step.dt, step.lands);
             let mut round = exchange::exchange(nodes, &interface_ids, summary, clock.step, clock.t, commands)?;

@@ -2,6 +2,7 @@
 //! on.
 
 use cosim_proto::scene::{whole_fluid_steps, ContactAlgorithm, Scene, SUBSTEP_SLACK};
+use cosim_proto::Num;
 
 use super::exchange::Round;
 use crate::summary::Summary;
@@ -186,6 +187,40 @@ impl Clock {
         self.t = if step.lands { step.target } else { self.t + step.dt };
         summary.steps = self.step;
         summary.sim_time = self.t;
+    }
+
+    /// A step that cannot move the run on: one shorter than `coupling.max_dt` / 2^32, or too short to advance `t` in
+    /// double precision. A node's stable step or speed collapsed (or a restored bound did), and the run would take
+    /// steps for ever at a frozen time; it ends `unstable`, naming the node and the value that set the step (the
+    /// fluid node ends its own run the same way where one coupling step would take it 2^32 of its steps).
+    pub fn check_step(&self, step: &Step) -> Result<(), crate::link::LinkError> {
+        let floor = self.max_dt / 4_294_967_296.0;
+        if step.lands || (step.dt >= floor && self.t + step.dt > self.t) {
+            return Ok(());
+        }
+        let (node, what, value) = [
+            ("sph-node", "sph/state dt_stable", self.dt_fluid),
+            ("contact-broker", "the contact's bound on the step", self.dt_contact),
+            (
+                "fem-node",
+                "the bound its fem/state v sets on the step",
+                self.dt_structure,
+            ),
+        ]
+        .into_iter()
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+        .expect("three bounds");
+        Err(crate::link::LinkError::Unstable {
+            node: node.into(),
+            message: format!(
+                "the coupling step collapsed to {} s at t = {} s, under coupling.max_dt / 2^32 = {} s or too short to \
+                 advance the time: {what} = {} s",
+                Num(step.dt),
+                Num(self.t),
+                Num(floor),
+                Num(value)
+            ),
+        })
     }
 
     /// The output step `step` was sampled: the next output time is the one after its target.

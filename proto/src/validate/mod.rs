@@ -12,12 +12,16 @@ use crate::messages::{
     Correction, FemMesh, FemSnapshot, FemState, Segment, SphSetup, SphSnapshot, SphState, StepCommand,
 };
 
+/// The largest magnitude a number of a message may hold: the largest a scene's physical value may take
+/// (`scene::MAGNITUDES`).
+pub const LARGEST: f64 = 1e50;
+
 /// What makes a message unusable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     /// Ids out of range, lengths that disagree, impossible parameters.
     Inconsistent,
-    /// A NaN or an infinity where a state holds numbers: the sender blew up.
+    /// A NaN, an infinity or a number beyond ±[`LARGEST`] where a state holds numbers: the sender blew up.
     NonFinite,
 }
 
@@ -93,13 +97,16 @@ impl Check {
         }
     }
 
+    /// A number a state can hold: finite, and within ±[`LARGEST`] (a node that reports 1e200 m/s has blown up as
+    /// surely as one that reports an infinity, and its squares and products would overflow the contact, the
+    /// probes and the energy balance: a structure at ±1e308 m held the broker's contact grid in an endless loop).
     fn finite(self, field: &'static str, index: &[usize], v: f64) -> Result {
-        if v.is_finite() {
+        if v.is_finite() && v.abs() <= LARGEST {
             Ok(())
         } else {
             Err(Invalid {
                 kind: Kind::NonFinite,
-                ..self.fail(field, index, format!("{v:?}"), "not a finite number")
+                ..self.fail(field, index, format!("{v:?}"), "not a finite number within ±1e50")
             })
         }
     }
@@ -119,12 +126,12 @@ impl Check {
             .try_for_each(|(i, v)| self.finite(field, &[i], *v))
     }
 
-    /// A finite number > 0 (masses, densities, lengths).
+    /// A number > 0 and at most [`LARGEST`] (masses, densities, lengths).
     fn positive(self, field: &'static str, index: &[usize], v: f64) -> Result {
-        if v.is_finite() && v > 0.0 {
+        if v > 0.0 && v <= LARGEST {
             Ok(())
         } else {
-            Err(self.fail(field, index, format!("{v:?}"), "must be a finite number > 0"))
+            Err(self.fail(field, index, format!("{v:?}"), "must be a number > 0 and ≤ 1e50"))
         }
     }
 
@@ -139,10 +146,11 @@ impl Check {
 
     /// Seconds of computation: finite and ≥ 0.
     fn seconds(self, field: &'static str, v: f64) -> Result {
-        if v.is_finite() && v >= 0.0 {
+        // At most 1e9 s (31 years) a step: the run's totals (summary.json `timings`) stay finite.
+        if v.is_finite() && (0.0..=1e9).contains(&v) {
             Ok(())
         } else {
-            Err(self.fail(field, &[], format!("{v:?}"), "must be a finite number ≥ 0"))
+            Err(self.fail(field, &[], format!("{v:?}"), "must be a number of seconds within 0…1e9"))
         }
     }
 

@@ -37,11 +37,11 @@ fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
         ),
         (
             |m| m.masses[1] = -1.0,
-            "fem/mesh masses[1] = -1.0: must be a finite number > 0",
+            "fem/mesh masses[1] = -1.0: must be a number > 0 and ≤ 1e50",
         ),
         (
             |m| m.nodes[3][1] = f64::NAN,
-            "fem/mesh nodes[3][1] = NaN: not a finite number",
+            "fem/mesh nodes[3][1] = NaN: not a finite number within ±1e50",
         ),
         (
             |m| m.cells[0][3] = 7,
@@ -58,11 +58,11 @@ fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
         (|m| m.fixed.push(9), "fem/mesh fixed[2] = 9: out of range (4 nodes)"),
         (
             |m| m.dt_stable = 0.0,
-            "fem/mesh dt_stable = 0.0: must be a finite number > 0",
+            "fem/mesh dt_stable = 0.0: must be a number > 0 and ≤ 1e50",
         ),
         (
             |m| m.dt_stable = f64::NAN,
-            "fem/mesh dt_stable = NaN: must be a finite number > 0",
+            "fem/mesh dt_stable = NaN: must be a number > 0 and ≤ 1e50",
         ),
     ];
     for (spoil, want) in cases {
@@ -102,7 +102,37 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
     nan.v[1][0] = f64::INFINITY;
     let e = nan.validate(&m, asked).unwrap_err();
     assert!(e.is_non_finite());
-    assert_eq!(e.to_string(), "fem/state v[1][0] = inf: not a finite number");
+    assert_eq!(
+        e.to_string(),
+        "fem/state v[1][0] = inf: not a finite number within ±1e50"
+    );
+    // Finite but beyond any state a run can hold (found 2026-12-06 by a sweep of hostile external nodes: a structure
+    // at ±1e308 m held the broker's contact grid in an endless loop, one at 1e200 m/s blew up the fluid node, which
+    // took the blame): refused as a node that blew up.
+    let mut far = state.clone();
+    far.x[3][1] = -1e308;
+    let e = far.validate(&m, asked).unwrap_err();
+    assert!(e.is_non_finite());
+    assert_eq!(
+        e.to_string(),
+        "fem/state x[3][1] = -1e308: not a finite number within ±1e50"
+    );
+    let mut fast = state.clone();
+    fast.v[0][0] = 1e200;
+    assert!(fast.validate(&m, asked).unwrap_err().is_non_finite());
+    let mut edge = state.clone();
+    edge.x[3][1] = 1e50;
+    assert_eq!(edge.validate(&m, asked), Ok(()));
+    // Seconds of computation whose sum over a run would overflow summary.json's timings to null (a complete run's
+    // summary was then taken for a stub and overwritten).
+    let mut slow = state.clone();
+    slow.compute_seconds = 1.7e308;
+    assert_eq!(
+        slow.validate(&m, asked).unwrap_err().to_string(),
+        "fem/state compute_seconds = 1.7e308: must be a number of seconds within 0…1e9"
+    );
+    slow.compute_seconds = 1e9;
+    assert_eq!(slow.validate(&m, asked), Ok(()));
     let no_snapshot = Asked {
         snapshot: true,
         ..asked
