@@ -23,7 +23,7 @@ mod broker_state;
 pub mod restore_reply;
 
 use std::collections::BTreeMap;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -320,13 +320,36 @@ fn read_files(
             FILES.join(", ")
         );
         let path = dir.join(name);
-        let bytes = std::fs::read(&path).with_context(|| {
+        let unreadable = || {
             format!(
                 "{}: missing or unreadable, {} lists it",
                 path.display(),
                 manifest_path.display()
             )
-        })?;
+        };
+        // A regular file of the size the manifest says, before a byte is read: a link to /dev/zero was read until
+        // the memory ran out, and a FIFO held the restart for ever (found 2026-12-06 by a sweep of crafted
+        // checkpoints).
+        let meta = std::fs::metadata(&path).with_context(unreadable)?;
+        anyhow::ensure!(
+            meta.is_file(),
+            "{}: not a regular file ({}), {} lists it as one",
+            path.display(),
+            kind_of(&meta.file_type()),
+            manifest_path.display()
+        );
+        anyhow::ensure!(
+            meta.len() == entry.bytes,
+            "{}: {} bytes where {} says {}: the checkpoint is damaged (cut short or changed)",
+            path.display(),
+            meta.len(),
+            manifest_path.display(),
+            entry.bytes
+        );
+        let mut bytes = Vec::new();
+        std::fs::File::open(&path)
+            .and_then(|f| f.take(entry.bytes.saturating_add(1)).read_to_end(&mut bytes))
+            .with_context(unreadable)?;
         anyhow::ensure!(
             bytes.len() as u64 == entry.bytes,
             "{}: {} bytes where {} says {}: the checkpoint is damaged (cut short or changed)",
@@ -371,6 +394,19 @@ fn first_difference(ours: &str, theirs: &str) -> Option<(String, String)> {
                 return Some((show(x), show(y)));
             }
         }
+    }
+}
+
+/// What a path that is not a regular file is, in a message.
+fn kind_of(t: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    match () {
+        _ if t.is_dir() => "a folder",
+        _ if t.is_fifo() => "a FIFO",
+        _ if t.is_char_device() => "a character device",
+        _ if t.is_block_device() => "a block device",
+        _ if t.is_socket() => "a socket",
+        _ => "not a file",
     }
 }
 

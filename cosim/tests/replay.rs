@@ -304,3 +304,54 @@ fn an_unstable_runs_trace_replays_its_failure() {
     // Every answer and the failure itself.
     assert_eq!(matched(&replay(&[&trace_of(&out), "--node", "sph"])), states + 1);
 }
+
+/// A replay "matches" only what it checked (found 2026-12-06 by a sweep of damaged traces): a trace with a state
+/// record removed from its middle replayed "matched 2 steps" of 315 and exit 0, and a node answering compute_seconds
+/// = NaN (the one field the comparison masks, which a live run refuses) matched every step. Now the first is a damaged
+/// trace (exit 2, one line) and the second a failure at its step (exit 1).
+#[test]
+fn a_damaged_trace_or_an_unusable_answer_is_not_a_match() {
+    let out = record("replay_damaged", &["--record"]);
+    let full = std::fs::read(out.join("trace/trace.bin")).unwrap();
+    let records = cosim_proto::trace::parse(&full).unwrap().records;
+    let (mut at, mut cut) = (cosim_proto::trace::HEADER_BYTES, None);
+    for r in &records {
+        let len = 8 + 10 + r.payload.len();
+        if r.kind == cosim_proto::trace::Kind::State && r.node == cosim_proto::trace::Node::Fem && r.step == 100 {
+            cut = Some((at, at + len));
+        }
+        at += len;
+    }
+    let (from, to) = cut.expect("fem-node's answer to step 100 in the trace");
+    let dir = scratch("replay_damaged_trace");
+    std::fs::write(dir.join("trace.bin"), [&full[..from], &full[to..]].concat()).unwrap();
+    let dir_s = dir.display().to_string();
+    let got = replay(&[&dir_s, "--node", "fem"]);
+    let said = text(&got);
+    assert_eq!(got.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("the command of step 100 has no answer, yet step 101 follows it: the trace is damaged"),
+        "{said}"
+    );
+    // The other node's part of the same file is whole.
+    assert_eq!(matched(&replay(&[&dir_s, "--node", "sph"])), 315);
+    // A device is not a trace, and is not read (/dev/zero was read until 6.5 GB were taken).
+    let zero = replay(&["/dev/zero", "--node", "fem"]);
+    assert_eq!(zero.status.code(), Some(2), "{}", text(&zero));
+    assert!(
+        text(&zero).contains("/dev/zero: not a regular file, so not a trace"),
+        "{}",
+        text(&zero)
+    );
+
+    let trace = trace_of(&out);
+    let fem = program("fem-node").display().to_string();
+    let nan = format!("env COSIM_TEST_NAN_SECONDS_STEP=7 {fem}");
+    let got = replay(&[&trace, "--node", "fem", "--exec", &nan]);
+    let said = text(&got);
+    assert_eq!(got.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("step 7: fem-node answered fem/state compute_seconds = NaN: must be a number of seconds"),
+        "{said}"
+    );
+}

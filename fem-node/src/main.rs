@@ -7,11 +7,14 @@ use fem_node::core::FemCore;
 
 /// Test double for `cosim replay` (`cosim/tests/replay.rs`): with `COSIM_TEST_PERTURB_STEP=K` in its environment the
 /// node answers its K-th command (step K of a run started from the scene) with its first reported position one ulp
-/// off, and is otherwise the real node. Unset, nothing changes.
+/// off, and is otherwise the real node; with `COSIM_TEST_NAN_SECONDS_STEP=K`, its `compute_seconds` NaN there. Unset,
+/// nothing changes.
 const PERTURB: &str = "COSIM_TEST_PERTURB_STEP";
+const NAN_SECONDS: &str = "COSIM_TEST_NAN_SECONDS_STEP";
 
 fn main() {
-    let perturb = std::env::var(PERTURB).ok().and_then(|v| v.parse::<u64>().ok());
+    let step = |var: &str| std::env::var(var).ok().and_then(|v| v.parse::<u64>().ok());
+    let (perturb, nan_seconds) = (step(PERTURB), step(NAN_SECONDS));
     cosim_bus::cli::node_main(cosim_proto::keys::FEM, |scene| {
         // Sized before anything is built: a scene too big for this machine fails with one line, not an abort.
         cosim_bus::memory::node_fits(scene, Part::Structure)?;
@@ -19,6 +22,7 @@ fn main() {
         Ok(Perturbed {
             core,
             at: perturb,
+            nan_seconds,
             answered: 0,
         })
     })
@@ -28,6 +32,7 @@ fn main() {
 struct Perturbed {
     core: FemCore,
     at: Option<u64>,
+    nan_seconds: Option<u64>,
     answered: u64,
 }
 
@@ -46,6 +51,10 @@ impl NodeCore for Perturbed {
             if let Some(p) = s.x.first_mut() {
                 p[0] = f64::from_bits(p[0].to_bits() + 1);
             }
+        }
+        if let (Some(s), Some(_)) = (state.as_mut(), self.nan_seconds.filter(|&k| k == self.answered)) {
+            eprintln!("fem-node: {NAN_SECONDS}: answering with compute_seconds NaN");
+            s.compute_seconds = f64::NAN;
         }
         self.answered += 1;
         Ok(state)

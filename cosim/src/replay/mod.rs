@@ -298,6 +298,29 @@ impl Player {
 
     fn compare(&self, x: &Exchange, got: &Answer, tol: Option<Tolerance>) -> Result<(), Failed> {
         let (error, state) = (self.topics.error, self.topics.state);
+        // The one field the comparison leaves out is checked as a live run checks it (docs/PROTOCOL.md §7): a node
+        // answering compute_seconds = NaN "matched" every step, where the broker would have refused it.
+        if let Answer::State(rep) = got {
+            let seconds = |rep: &[u8]| {
+                let run = RawEnvelope::split(rep)?.run;
+                match self.node_kind {
+                    ExternalNode::Fem => Envelope::<FemState>::decode(rep, run, state)
+                        .ok()
+                        .map(|e| e.body.compute_seconds),
+                    ExternalNode::Sph => Envelope::<SphState>::decode(rep, run, state)
+                        .ok()
+                        .map(|e| e.body.compute_seconds),
+                }
+            };
+            if let Some(s) = seconds(rep).filter(|s| !(0.0..=1e9).contains(s)) {
+                return Err(Failed(format!(
+                    "step {}: {} answered {state} compute_seconds = {}: must be a number of seconds within 0…1e9",
+                    x.step,
+                    self.topics.name,
+                    cosim_proto::Num(s)
+                )));
+            }
+        }
         let d = match (x.answer.as_ref(), got) {
             (Some(Answer::State(rec)), Answer::State(rep)) => match self.node_kind {
                 ExternalNode::Fem => diff::compare::<FemState>(state, rec, rep, tol, |s| s.compute_seconds = 0.0),

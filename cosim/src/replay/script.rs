@@ -63,6 +63,9 @@ pub fn trace_file(path: &Path) -> PathBuf {
 /// that does not decode) is an error naming the file and the record.
 pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
     let path = trace_file(path);
+    // A regular file, before it is read whole: /dev/zero was read until 6.5 GB were taken (2026-12-06).
+    let meta = std::fs::metadata(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    anyhow::ensure!(meta.is_file(), "{}: not a regular file, so not a trace", path.display());
     let bytes = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
     let who = match node {
         ExternalNode::Fem => Node::Fem,
@@ -120,6 +123,22 @@ pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
                     x.answer.get_or_insert(answer);
                 }
             }
+        }
+    }
+    // A command without an answer ends a trace cut short (the run killed while the node computed); one with later
+    // steps after it is a record lost or changed inside the trace, which would otherwise replay as "matched" up to
+    // there (found 2026-12-06: a state record removed, or a command's step changed, replayed "matched 2 steps"
+    // of 51, exit 0).
+    if let Some(k) = exchanges.iter().position(|x| !x.stop && x.answer.is_none()) {
+        let x = &exchanges[k];
+        if let Some(later) = exchanges[k + 1..].iter().find(|y| y.step != x.step) {
+            anyhow::bail!(
+                "{}: the command of step {} has no answer, yet step {} follows it: the trace is damaged (a record lost \
+                 or changed)",
+                path.display(),
+                x.step,
+                later.step
+            );
         }
     }
     let what = node.program();
