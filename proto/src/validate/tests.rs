@@ -64,6 +64,17 @@ fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
             |m| m.dt_stable = f64::NAN,
             "fem/mesh dt_stable = NaN: must be a number > 0 and ≤ 1e50",
         ),
+        // The contact's geometry (2026-12-06): a segment between two nodes at one point, and a boundary that goes
+        // clockwise (its normals point into the solid).
+        (
+            |m| m.nodes[2] = m.nodes[1],
+            "fem/mesh interface[1] = 1→2: a segment of zero length (both nodes at [1.0, 0.0])",
+        ),
+        (
+            |m| m.interface.iter_mut().for_each(|s| (s.a, s.b) = (s.b, s.a)),
+            "fem/mesh interface = the segments of solid 0 (plate): they go clockwise round it or enclose nothing \
+             (signed area -1e0 m²): they must go counter-clockwise, so that their normals point out of the solid",
+        ),
     ];
     for (spoil, want) in cases {
         let mut m = mesh();
