@@ -210,11 +210,23 @@ fn serve(
     let wait = cosim_bus::seconds::wait(args.wait_nodes);
     let step_timeout = cosim_bus::seconds::wait(scene.scene.coupling.step_timeout);
     let mut fem: Option<ZenohLink<FemMesh, FemState>> = match fem_subs {
-        Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
+        Some(subs) => Some(ZenohLink::register(
+            &session,
+            &args.run,
+            subs,
+            (wait, interrupt),
+            step_timeout,
+        )?),
         None => None,
     };
     let mut sph: Option<ZenohLink<SphSetup, SphState>> = match sph_subs {
-        Some(subs) => Some(ZenohLink::register(&session, &args.run, subs, wait, step_timeout)?),
+        Some(subs) => Some(ZenohLink::register(
+            &session,
+            &args.run,
+            subs,
+            (wait, interrupt),
+            step_timeout,
+        )?),
         None => None,
     };
     // Ctrl-C during a long step: the wait for the nodes' answers is given up, the outputs so far written.

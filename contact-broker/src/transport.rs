@@ -141,12 +141,12 @@ fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkErr
 }
 
 impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
-    /// Wait (at most `wait`) for the node to register, then build the link.
+    /// Wait (at most `wait`, and until `interrupt` arrives) for the node to register, then build the link.
     pub fn register(
         session: &Session,
         run: &str,
         subs: Subscriptions,
-        wait: Duration,
+        (wait, interrupt): (Duration, &Interrupt),
         step_timeout: Duration,
     ) -> anyhow::Result<Self> {
         let topics = subs.topics;
@@ -173,6 +173,11 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
                 if let Some(e) = node_error(&sample, run, &topics) {
                     return Err(e.into());
                 }
+            }
+            // Ctrl-C while a node is awaited (an outside node not started yet): the run ends at once, as between two
+            // steps (it went on waiting until `cosim run` killed it 10 s later, found 2026-12-06).
+            if interrupt.arrived() {
+                anyhow::bail!("{REASON}, while waiting for {} to register", topics.name);
             }
             if Instant::now() > deadline {
                 let why = refused.map(|r| format!(" (refused: {r})")).unwrap_or_default();

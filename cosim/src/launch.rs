@@ -403,7 +403,10 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
                     .iter()
                     .map(|n| last_line(&logs.join(format!("{n}.log"))))
                     .collect();
-                format!("{how}; {}", nodes.join("; "))
+                match nodes.is_empty() {
+                    true => how,
+                    false => format!("{how}; {}", nodes.join("; ")),
+                }
             };
             let (samples, sim_time, frames) = kept_outputs(&info.out);
             let summary = SummaryBuilder::new(&info.run_id, &info.mode)

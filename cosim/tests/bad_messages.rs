@@ -29,6 +29,8 @@ const SETS: [&str; 6] = [
 /// The coarse hydrostatic plate with an outside structure node: `cosim run` waiting for it, and where to join.
 struct Outside {
     run: Kill,
+    /// The test's folder, kept while the run is.
+    _dir: Scratch,
     out: std::path::PathBuf,
     id: String,
     endpoint: String,
@@ -86,6 +88,7 @@ fn outside(name: &str) -> Outside {
     .unwrap();
     Outside {
         run,
+        _dir: dir,
         out,
         id,
         endpoint,
@@ -228,4 +231,32 @@ fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
     );
     let steps = summary["steps"].as_u64().unwrap();
     assert!(steps < 10, "the run went on to its end: {steps} steps");
+}
+
+/// SIGTERM to `cosim run` while it waits for an outside node that never comes ends the run at once, as between two
+/// steps: `failed`, "interrupted (SIGINT or SIGTERM)", exit 1 (found 2026-12-06: the broker went on waiting, `cosim
+/// run` killed it 10 s later, and the summary said "contact-broker died (signal 9); ").
+#[test]
+fn an_interrupt_while_a_node_is_awaited_ends_the_run_at_once() {
+    let mut o = outside("bad_messages_interrupt_waiting");
+    let pid = o.run.0.id().to_string();
+    let sent = Instant::now();
+    assert!(Command::new("kill").args(["-TERM", &pid]).status().unwrap().success());
+    let status = loop {
+        if let Some(status) = o.run.0.try_wait().unwrap() {
+            break status;
+        }
+        assert!(sent.elapsed() < LIMIT, "the run did not end after SIGTERM");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let took = sent.elapsed().as_secs_f64();
+    let (status, summary, _) = o.ended(status);
+    assert_eq!(status.code(), Some(1), "{summary}");
+    assert_eq!(summary["status"], "failed", "{summary}");
+    let message = summary["message"].as_str().unwrap_or_default();
+    assert!(
+        message.contains("interrupted (SIGINT or SIGTERM), while waiting for fem-node to register"),
+        "{message}"
+    );
+    assert!(took < 5.0, "ended {took:.1} s after SIGTERM");
 }

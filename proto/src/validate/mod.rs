@@ -238,13 +238,19 @@ impl FemMesh {
                     format!("a segment of zero length (both nodes at {pa:?})"),
                 ));
             }
-            let solid = self.node_solid.get(*a as usize).filter(|&&s| self.node_solid.get(*b as usize) == Some(&s));
+            let solid = self
+                .node_solid
+                .get(*a as usize)
+                .filter(|&&s| self.node_solid.get(*b as usize) == Some(&s));
             if let Some(slot) = solid.and_then(|&s| area.get_mut(s as usize)) {
                 *slot += 0.5 * (pa[0] * pb[1] - pa[1] * pb[0]);
             }
         }
         for ((s, a), name) in area.iter().enumerate().zip(&self.solid_names) {
-            let has = self.interface.iter().any(|g| self.node_solid.get(g.a as usize) == Some(&(s as u32)));
+            let has = self
+                .interface
+                .iter()
+                .any(|g| self.node_solid.get(g.a as usize) == Some(&(s as u32)));
             if has && (a.is_nan() || *a <= 0.0) {
                 return Err(c.fail(
                     "interface",
