@@ -19,6 +19,14 @@ use crate::look::{self, Look};
 
 /// Run `cosim snapshot`.
 pub fn snapshot(args: &SnapshotArgs) -> anyhow::Result<ExitCode> {
+    // The frames are numbered 0: in a run's own folder they took the place of its first frames, which its .pvd
+    // still listed at t = 0 (found 2026-12-06). A snapshot's folder holds snapshots.
+    anyhow::ensure!(
+        !args.out.join("summary.json").exists(),
+        "--out {}: holds a run's outputs (summary.json); the snapshot's frames would take the place of its first \
+         ones: give the snapshot a folder of its own",
+        args.out.display()
+    );
     let (session, connect) = join(&args.id, &args.join)?;
     let look = match look::fetch(&session, &args.id, cosim_bus::seconds::wait(args.join.timeout)) {
         Ok(look) => look,

@@ -148,6 +148,12 @@ fn break_snapshot_step_and_resume_leave_the_run_bit_identical() {
     let made = doc["nodes"]["contact-broker"]["extra"]["energy_made"].as_f64();
     assert!(made.is_some_and(|g| (0.0..0.01).contains(&g)), "{doc:#}");
 
+    // Not into the run's own folder, whose first frames it would replace (2026-12-06): exit 2, the frame kept.
+    let first = std::fs::read(out.join("frames/structure_00000.vtu")).unwrap();
+    let (code, _, text) = cosim_json(&["snapshot", &id, "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("holds a run's outputs (summary.json)"), "{text}");
+    assert!(std::fs::read(out.join("frames/structure_00000.vtu")).unwrap() == first);
     // A snapshot while paused: the mesh, the particles, the last pass's contacts.
     let snap = dir.join("snapshot");
     let (code, _, text) = cosim_json(&["snapshot", &id, "--out", snap.to_str().unwrap()]);

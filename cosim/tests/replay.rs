@@ -354,4 +354,36 @@ fn a_damaged_trace_or_an_unusable_answer_is_not_a_match() {
         said.contains("step 7: fem-node answered fem/state compute_seconds = NaN: must be a number of seconds"),
         "{said}"
     );
+
+    // What an --exec wrapper starts beside the node ends with the replay (a wrapper's child outlived it).
+    let wrapper = dir.join("wrapper.sh");
+    let pid_file = dir.join("sleep.pid");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\nsleep 321 &\necho $! > {}\nexec {fem} \"$@\"\n",
+            pid_file.display()
+        ),
+    )
+    .unwrap();
+    std::fs::set_permissions(&wrapper, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let wrapper_s = wrapper.display().to_string();
+    assert_eq!(matched(&replay(&[&trace, "--node", "fem", "--exec", &wrapper_s])), 315);
+    let pid = std::fs::read_to_string(&pid_file).unwrap().trim().to_string();
+    // Alive: in /proc and not a zombie (killed, it waits there for init to reap it).
+    let running = || {
+        std::fs::read_to_string(format!("/proc/{pid}/stat"))
+            .ok()
+            .and_then(|s| s.rsplit(')').next().map(|rest| !rest.trim_start().starts_with('Z')))
+            .unwrap_or(false)
+    };
+    let since = Instant::now();
+    while running() && since.elapsed() < Duration::from_secs(2) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let alive = running();
+    if alive {
+        let _ = Command::new("kill").arg(&pid).status();
+    }
+    assert!(!alive, "the wrapper's child {pid} outlived the replay");
 }

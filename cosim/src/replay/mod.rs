@@ -4,6 +4,7 @@
 //! recorded commands in order, and compares each answer with the recorded one (`diff`). The first divergence is
 //! named with its step, message, field, index and both values (exit 1); otherwise one line, "matched N steps".
 
+use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Child, Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
@@ -27,15 +28,16 @@ pub mod script;
 use diff::{Divergence, Tolerance};
 use script::{Answer, Exchange, Script};
 
-/// Kills the node when dropped, so no early return leaves it running.
+/// Kills the node when dropped, so no early return leaves it running: its whole process group, which it leads, so
+/// that what an `--exec` script started goes with it (a wrapper's node outlived the replay, found 2026-12-06).
 struct Node(Child);
 
 impl Drop for Node {
     fn drop(&mut self) {
-        if self.0.try_wait().ok().flatten().is_none() {
-            let _ = self.0.kill();
-            let _ = self.0.wait();
-        }
+        let group = nix::unistd::Pid::from_raw(self.0.id() as i32);
+        let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+        let _ = self.0.kill();
+        let _ = self.0.wait();
     }
 }
 
@@ -371,6 +373,7 @@ fn spawn(args: &ReplayArgs, run: &str, endpoint: &str, log: &Path) -> anyhow::Re
     };
     let log_file = std::fs::File::create(log).with_context(|| format!("cannot create {}", log.display()))?;
     cmd.args(["--run", run, "--connect", endpoint])
+        .process_group(0)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(log_file)
