@@ -366,6 +366,11 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         if env.body.node != self.topics.name {
             return Err(self.failed(format!("sent a checkpoint of a {}", env.body.node)));
         }
+        // Empty bytes stand for "no such node" where a checkpoint or a snapshot is read (docs/PROTOCOL.md §11): a
+        // node of the run sending none read as a run without a structure (found 2026-12-06).
+        if env.body.data.is_empty() {
+            return Err(self.failed(format!("sent an empty {what}: a node of the run saves its state")));
+        }
         Ok(env.body.data)
     }
 
@@ -399,6 +404,9 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
         // A message that is not this run's answer to this step (malformed, another version, run or step) is
         // refused: logged, never applied, and the wait goes on (`docs/PROTOCOL.md` §7).
         let mut refused: Option<String> = None;
+        // The last answer to an earlier step that came instead: a node that numbers its answers one behind was
+        // said to have sent nothing (found 2026-12-06).
+        let mut earlier: Option<u64> = None;
         loop {
             match self.state.recv_timeout(Duration::from_millis(100)) {
                 Ok(Some(sample)) => {
@@ -422,6 +430,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                         // An answer to an earlier step, sent again after the broker sent its command again.
                         Err(CodecError::Step { got, .. }) if got < step => {
                             tracing::debug!("{}: a repeated answer to step {got}, dropped", self.topics.name);
+                            earlier = Some(got);
                         }
                         Err(e) => {
                             let e: CodecError = e;
@@ -453,7 +462,11 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                 }
             }
             if Instant::now() > deadline {
-                let why = refused.map(|r| format!("; refused instead: {r}")).unwrap_or_default();
+                let why = match (refused, earlier) {
+                    (Some(r), _) => format!("; refused instead: {r}"),
+                    (None, Some(got)) => format!("; it answered step {got} instead, an earlier step's number"),
+                    (None, None) => String::new(),
+                };
                 return Err(self.failed(format!(
                     "no answer to step {step} within {:.0} s (coupling.step_timeout){why}",
                     self.step_timeout.as_secs_f64()

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use common::*;
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic};
-use cosim_proto::messages::{FemMesh, NodeError, StepCommand};
+use cosim_proto::messages::{FemMesh, NodeCheckpoint, NodeError, StepCommand};
 use fem_node::core::FemCore;
 use zenoh::Wait;
 
@@ -39,6 +39,11 @@ struct Outside {
 }
 
 fn outside(name: &str) -> Outside {
+    outside_with(name, &[])
+}
+
+/// [`outside`] with more arguments to `cosim run`.
+fn outside_with(name: &str, more: &[&str]) -> Outside {
     let dir = scratch(name);
     let out = dir.join("out");
     let id = run_id(name);
@@ -57,6 +62,7 @@ fn outside(name: &str) -> Outside {
             .args(["--quiet", "--run-id", &id, "--out"])
             .arg(&out)
             .args(SETS)
+            .args(more)
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(std::fs::File::create(dir.join("stderr.txt")).unwrap())
@@ -164,9 +170,14 @@ fn an_unusable_mesh_from_an_outside_node_fails_the_run_naming_the_field() {
 /// node whose watchdog fires on another thread would (found 2026-12-06 by a sweep of hostile external nodes): the run
 /// ended `ok`, exit 0, because the broker read the node's error topic only while it waited for an answer that did
 /// not come. Now a failure reported before an answer ends the run with it, naming the node and its message.
-#[test]
-fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
-    let o = outside("bad_messages_error_then_answers");
+/// An outside structure node that answers every command with the real solver, under the step number `tamper(step)`,
+/// sends what `extra(session, run, step, t)` sends before each answer, and answers a checkpoint query with no bytes;
+/// the run's exit status, summary and the broker's log once it ended.
+fn answering(
+    mut o: Outside,
+    tamper: impl Fn(u64) -> u64,
+    extra: impl Fn(&zenoh::Session, &str, u64, f64),
+) -> (std::process::ExitStatus, serde_json::Value, String) {
     let mut core = FemCore::new(&o.scene.scene).unwrap();
     let mesh = Envelope::new(&o.id, 0, 0.0, core.mesh().clone()).encode();
     let (session, _) = cosim_bus::session::open_listening(
@@ -184,44 +195,66 @@ fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
         .declare_subscriber(key(&o.id, topic::BROKER_FEM))
         .wait()
         .unwrap();
-    let mut run = o;
-    let mut registered = false;
+    let checkpoints = session
+        .declare_queryable(key(&o.id, topic::FEM_CHECKPOINT))
+        .wait()
+        .unwrap();
+    let (mut registered, mut answered) = (false, (0u64, 0.0f64));
     let status = loop {
-        if let Some(status) = run.run.0.try_wait().unwrap() {
+        while let Ok(Some(query)) = checkpoints.try_recv() {
+            let empty = NodeCheckpoint {
+                node: "fem-node".into(),
+                data: Vec::new(),
+            };
+            let bytes = Envelope::new(&o.id, answered.0, answered.1, empty).encode();
+            query.reply(query.key_expr().clone(), bytes).wait().unwrap();
+        }
+        if let Some(status) = o.run.0.try_wait().unwrap() {
             break status;
         }
-        assert!(
-            run.started.elapsed() < LIMIT,
-            "the run did not end after the node's failure"
-        );
+        assert!(o.started.elapsed() < LIMIT, "the run did not end");
         if !registered {
-            session.put(key(&run.id, topic::FEM_MESH), mesh.clone()).wait().unwrap();
+            session.put(key(&o.id, topic::FEM_MESH), mesh.clone()).wait().unwrap();
         }
         let Ok(Some(sample)) = commands.recv_timeout(Duration::from_millis(200)) else {
             continue;
         };
         registered = true;
         let bytes = sample.payload().to_bytes();
-        let Ok(cmd) = Envelope::<StepCommand>::decode(&bytes, &run.id, topic::BROKER_FEM) else {
+        let Ok(cmd) = Envelope::<StepCommand>::decode(&bytes, &o.id, topic::BROKER_FEM) else {
             continue;
         };
         let (step, t) = (cmd.step, cmd.t);
+        extra(&session, &o.id, step, t);
+        if let Ok(Some(state)) = core.handle(&cmd.body) {
+            let bytes = Envelope::new(&o.id, tamper(step), t, state).encode();
+            session.put(key(&o.id, topic::FEM_STATE), bytes).wait().unwrap();
+            answered = (step, t + cmd.body.dt);
+        }
+    };
+    drop((commands, checkpoints));
+    drop(session);
+    o.ended(status)
+}
+
+/// An outside structure node that reports itself `unstable` on its error topic and then goes on answering, as a
+/// node whose watchdog fires on another thread would (found 2026-12-06 by a sweep of hostile external nodes): the run
+/// ended `ok`, exit 0, because the broker read the node's error topic only while it waited for an answer that did
+/// not come. Now a failure reported before an answer ends the run with it, naming the node and its message.
+#[test]
+fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
+    let o = outside("bad_messages_error_then_answers");
+    let report = |session: &zenoh::Session, id: &str, step: u64, t: f64| {
         if step == 2 {
             let report = NodeError {
                 status: "unstable".into(),
                 message: "the outside node's own check failed".into(),
             };
-            let bytes = Envelope::new(&run.id, step, t, report).encode();
-            session.put(key(&run.id, topic::FEM_ERROR), bytes).wait().unwrap();
-        }
-        if let Ok(Some(state)) = core.handle(&cmd.body) {
-            let bytes = Envelope::new(&run.id, step, t, state).encode();
-            session.put(key(&run.id, topic::FEM_STATE), bytes).wait().unwrap();
+            let bytes = Envelope::new(id, step, t, report).encode();
+            session.put(key(id, topic::FEM_ERROR), bytes).wait().unwrap();
         }
     };
-    drop(commands);
-    drop(session);
-    let (status, summary, _) = run.ended(status);
+    let (status, summary, _) = answering(o, |step| step, report);
     assert_eq!(status.code(), Some(1), "{summary}");
     assert_eq!(summary["status"], "unstable", "{summary}");
     let message = summary["message"].as_str().unwrap();
@@ -231,6 +264,23 @@ fn a_node_that_reports_a_failure_and_keeps_answering_ends_the_run() {
     );
     let steps = summary["steps"].as_u64().unwrap();
     assert!(steps < 10, "the run went on to its end: {steps} steps");
+}
+
+/// A node that numbers its answers one step behind from step 3 on is said to have answered an earlier step, not
+/// to have sent nothing (found 2026-12-06: "no answer to step 3 within … s").
+#[test]
+fn answers_under_an_earlier_step_are_said_in_the_timeout() {
+    let o = outside_with("bad_messages_one_behind", &["--set", "coupling.step_timeout=1.5"]);
+    let (status, summary, _) = answering(o, |step| if step >= 3 { step - 1 } else { step }, |_, _, _, _| ());
+    assert_eq!(status.code(), Some(1), "{summary}");
+    let message = summary["message"].as_str().unwrap();
+    assert!(
+        message.contains(
+            "fem-node: no answer to step 3 within 2 s (coupling.step_timeout); it answered step 2 \
+                          instead, an earlier step's number"
+        ),
+        "{message}"
+    );
 }
 
 /// SIGTERM to `cosim run` while it waits for an outside node that never comes ends the run at once, as between two
@@ -259,4 +309,41 @@ fn an_interrupt_while_a_node_is_awaited_ends_the_run_at_once() {
         "{message}"
     );
     assert!(took < 5.0, "ended {took:.1} s after SIGTERM");
+}
+
+/// A node of the run that answers a checkpoint query with no bytes is refused, naming it: empty bytes stand for "the
+/// run has no such node" where a paused run's state is read, and `cosim snapshot` of a paused run whose outside
+/// structure node did so wrote no structure frame, said "0 contact(s)" and exited 0 (found 2026-12-06).
+#[test]
+fn an_empty_checkpoint_from_a_node_of_the_run_is_refused() {
+    let o = outside_with("bad_messages_empty_checkpoint", &["--break", "step=3"]);
+    let (id, out) = (o.id.clone(), o.out.clone());
+    let node = std::thread::spawn(move || answering(o, |step| step, |_, _, _, _| ()));
+    let ctl = |args: &[&str]| {
+        let mut cmd = Command::new(cosim());
+        cmd.current_dir(root()).args(args);
+        run_bounded(&mut cmd, Duration::from_secs(30))
+    };
+    let since = Instant::now();
+    loop {
+        let status = ctl(&["ctl", &id, "status"]);
+        if String::from_utf8_lossy(&status.stdout).contains("paused at step 3") {
+            break;
+        }
+        assert!(since.elapsed() < LIMIT, "the run did not pause");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let snap = ctl(&["snapshot", &id, "--out", out.join("snap").to_str().unwrap()]);
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&snap.stdout),
+        String::from_utf8_lossy(&snap.stderr)
+    );
+    let _ = ctl(&["ctl", &id, "stop"]);
+    let _ = node.join();
+    assert_ne!(snap.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains("fem-node: sent an empty fem/checkpoint: a node of the run saves its state"),
+        "{said}"
+    );
 }
