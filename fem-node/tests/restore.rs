@@ -106,7 +106,12 @@ fn lengths_that_disagree_are_refused_naming_the_field() {
 fn values_that_are_not_finite_or_not_where_clamped_are_refused() {
     assert_eq!(
         refused(&edited(|s| s.x[4] = [f64::NAN, 0.1])),
-        "checkpoint: state.x[4] = [NaN, 0.1] is not finite"
+        "checkpoint: state.x[4] = [NaN, 0.1] is not finite within ±1e50"
+    );
+    // Finite but beyond any state (2026-12-06): the run failed at its first step as a collapsed element.
+    assert_eq!(
+        refused(&edited(|s| s.x[4] = [1e300, 0.1])),
+        "checkpoint: state.x[4] = [1e300, 0.1] is not finite within ±1e50"
     );
     assert_eq!(
         refused(&edited(|s| s.t = f64::INFINITY)),

@@ -30,20 +30,26 @@ pub(crate) fn len<T>(field: &str, values: &[T], n: usize, what: &str) -> Check {
     }
 }
 
-/// Every entry of `values` is finite.
+/// Every entry of `values` is finite, within ±1e50.
 pub(crate) fn finite(field: &str, values: &[f64]) -> Check {
-    match values.iter().position(|v| !v.is_finite()) {
+    match values.iter().position(|&v| far(v)) {
         None => Ok(()),
-        Some(k) => Err(format!("{field}[{k}] = {} is not finite", values[k])),
+        Some(k) => Err(format!("{field}[{k}] = {} is not finite within ±1e50", values[k])),
     }
 }
 
-/// Every vector of `values` is finite.
+/// Every vector of `values` is finite, within ±1e50.
 pub(crate) fn finite2(field: &str, values: &[[f64; 2]]) -> Check {
-    match values.iter().position(|v| !(v[0].is_finite() && v[1].is_finite())) {
+    match values.iter().position(|v| far(v[0]) || far(v[1])) {
         None => Ok(()),
-        Some(k) => Err(format!("{field}[{k}] = {:?} is not finite", values[k])),
+        Some(k) => Err(format!("{field}[{k}] = {:?} is not finite within ±1e50", values[k])),
     }
+}
+
+/// Not a number a state can hold: NaN, ±∞, or beyond ±1e50 (as every number of a message,
+/// `cosim_proto::validate::LARGEST`).
+fn far(v: f64) -> bool {
+    v.is_nan() || v.abs() > cosim_proto::validate::LARGEST
 }
 
 /// `saved` equals `want` bit for bit (same length, then every entry).

@@ -135,7 +135,7 @@ fn a_state_with_lengths_that_disagree_is_refused_naming_the_field() {
             "{solver}"
         );
         let e = refused(solver, &edited(solver, |s| s.solver.state.p[9] = f64::NAN));
-        assert_eq!(e, "checkpoint: state.p[9] = NaN is not finite", "{solver}");
+        assert_eq!(e, "checkpoint: state.p[9] = NaN is not finite within ±1e50", "{solver}");
         let e = refused(solver, &edited(solver, |s| s.solver.state.x[2] = [1e6, 0.0]));
         assert_eq!(
             e, "checkpoint: state.x[2] = [1000000.0, 0.0] is outside the fluid's domain",
