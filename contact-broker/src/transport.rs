@@ -126,11 +126,11 @@ fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkErr
         Ok(env) => Some(match RunStatus::of_node_report(&env.body.status) {
             RunStatus::Unstable => LinkError::Unstable {
                 node,
-                message: env.body.message,
+                message: cosim_proto::one_line(&env.body.message),
             },
             _ => LinkError::Failed {
                 node,
-                message: env.body.message,
+                message: cosim_proto::one_line(&env.body.message),
             },
         }),
         Err(e) => {

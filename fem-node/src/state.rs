@@ -51,7 +51,10 @@ impl FemState {
             // passed, and the run failed at its first step as a collapsed element, naming no checkpoint.
             let far = |v: f64| v.is_nan() || v.abs() > cosim_proto::validate::LARGEST;
             if let Some(k) = values.iter().position(|p| far(p[0]) || far(p[1])) {
-                return Err(format!("state.{field}[{k}] = {:?} is not finite within ±1e50", values[k]));
+                return Err(format!(
+                    "state.{field}[{k}] = {:?} is not finite within ±1e50",
+                    values[k]
+                ));
             }
         }
         let clamped = model

@@ -13,7 +13,7 @@ pub mod scene;
 pub mod trace;
 pub mod validate;
 
-pub use readable::Num;
+pub use readable::{one_line, Num};
 pub use scene::sizing;
 
 pub use envelope::{CodecError, Envelope, PROTOCOL_VERSION};

@@ -1,5 +1,5 @@
 //! Numbers as a message should show them: a value a user typed may be 1e-300 or 1e300, and Rust's `{}` writes
-//! every one of its digits (300 zeros), where a person reads `1e-300`.
+//! every one of its digits (300 zeros), where a person reads `1e-300`; and a node's own text as one printable line.
 
 use std::fmt;
 
@@ -22,9 +22,36 @@ impl fmt::Display for Num {
     }
 }
 
+/// A node's message as one printable line of at most 2,000 characters: control characters (a carriage return, a
+/// terminal's escape sequences) became spaces, so that what a node says cannot hide which node said it or rewrite
+/// the terminal (found 2026-12-06).
+pub fn one_line(message: &str) -> String {
+    const MOST: usize = 2000;
+    let mut line: String = message
+        .chars()
+        .take(MOST)
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    if message.chars().nth(MOST).is_some() {
+        line.push('…');
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
-    use super::Num;
+    use super::{one_line, Num};
+
+    #[test]
+    fn a_nodes_message_is_one_printable_line() {
+        assert_eq!(one_line("diverged\r\x1b[2Kfem-node: ok"), "diverged  [2Kfem-node: ok");
+        assert_eq!(one_line("a\nb"), "a b");
+        let long = "x".repeat(2500);
+        let line = one_line(&long);
+        assert_eq!(line.chars().count(), 2001);
+        assert!(line.ends_with('…'));
+        assert_eq!(one_line("ünïcode ok"), "ünïcode ok");
+    }
 
     #[test]
     fn usual_values_read_as_typed_and_extreme_ones_in_scientific_notation() {

@@ -259,7 +259,7 @@ impl Player {
             }
             if let Ok(Some(sample)) = self.error.try_recv() {
                 let why = Envelope::<NodeError>::decode(&sample.payload().to_bytes(), &self.run, self.topics.error)
-                    .map_or_else(|e| e.to_string(), |e| e.body.message);
+                    .map_or_else(|e| e.to_string(), |e| cosim_proto::one_line(&e.body.message));
                 return Err(Failed(format!("{} failed before {what}: {why}", self.topics.name)));
             }
             self.check_alive(what)?;
@@ -331,7 +331,7 @@ impl Player {
             (Some(Answer::Error(rec)), Answer::Error(rep)) => diff::compare::<NodeError>(error, rec, rep, None, |_| {}),
             (Some(Answer::State(_)), Answer::Error(rep)) => {
                 let why = Envelope::<NodeError>::decode(rep, &self.run, error)
-                    .map_or_else(|e| e.to_string(), |e| e.body.message);
+                    .map_or_else(|e| e.to_string(), |e| cosim_proto::one_line(&e.body.message));
                 return Err(Failed(format!(
                     "step {}: {} failed where the recorded node answered: {why}",
                     x.step, self.topics.name

@@ -35,7 +35,10 @@ fn a_restored_layer_is_checked_against_its_state() {
     );
     let mut bad = layer.clone();
     bad.time[0] = f64::NAN;
-    assert_eq!(bad.check(&moved), Err("contact.time[0] = NaN is not finite within ±1e50".into()));
+    assert_eq!(
+        bad.check(&moved),
+        Err("contact.time[0] = NaN is not finite within ±1e50".into())
+    );
     assert_eq!(
         layer.check(&state),
         Err("contact.v_end[1] = [0.0, -0.1] where state.v has [0.0, 0.0]".into())
