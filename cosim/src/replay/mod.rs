@@ -265,7 +265,7 @@ impl Player {
             self.check_alive(what)?;
             if Instant::now() > deadline {
                 return Err(Failed(format!(
-                    "{} sent no {what} within {:.0} s",
+                    "{} sent no registration within {:.0} s",
                     self.topics.name,
                     self.timeout.as_secs_f64()
                 )));
