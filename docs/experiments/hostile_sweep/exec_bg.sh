@@ -1,0 +1,4 @@
+#!/bin/sh
+sleep 778 &
+trap "" TERM
+sleep 779
