@@ -15,7 +15,7 @@ import sys
 import time
 import tomllib
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "examples", "python"))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "examples", "python"))
 import zenoh  # noqa: E402
 from rigid_plate_node import (RigidPlate, header, read_command, u32s, vec2s, f64s)  # noqa: E402
 
