@@ -209,12 +209,11 @@ fn serve(
 
     let wait = cosim_bus::seconds::wait(args.wait_nodes);
     let step_timeout = cosim_bus::seconds::wait(scene.scene.coupling.step_timeout);
-    let register = (wait, interrupt);
     let mut fem: Option<ZenohLink<FemMesh, FemState>> = fem_subs
-        .map(|subs| ZenohLink::register(&session, &args.run, subs, register, step_timeout))
+        .map(|subs| ZenohLink::register(&session, &args.run, subs, wait, interrupt, step_timeout))
         .transpose()?;
     let mut sph: Option<ZenohLink<SphSetup, SphState>> = sph_subs
-        .map(|subs| ZenohLink::register(&session, &args.run, subs, register, step_timeout))
+        .map(|subs| ZenohLink::register(&session, &args.run, subs, wait, interrupt, step_timeout))
         .transpose()?;
     // Ctrl-C during a long step: the wait for the nodes' answers is given up, the outputs so far written.
     if let Some(link) = fem.as_mut() {

@@ -123,16 +123,13 @@ pub struct ZenohLink<S, T> {
 fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkError> {
     let node = topics.name.to_string();
     match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, topics.error) {
-        Ok(env) => Some(match RunStatus::of_node_report(&env.body.status) {
-            RunStatus::Unstable => LinkError::Unstable {
-                node,
-                message: cosim_proto::one_line(&env.body.message),
-            },
-            _ => LinkError::Failed {
-                node,
-                message: cosim_proto::one_line(&env.body.message),
-            },
-        }),
+        Ok(env) => {
+            let message = cosim_proto::one_line(&env.body.message);
+            Some(match RunStatus::of_node_report(&env.body.status) {
+                RunStatus::Unstable => LinkError::Unstable { node, message },
+                _ => LinkError::Failed { node, message },
+            })
+        }
         Err(e) => {
             tracing::error!("{node}: refused an error report: {e}");
             None
@@ -146,7 +143,8 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         session: &Session,
         run: &str,
         subs: Subscriptions,
-        (wait, interrupt): (Duration, &Interrupt),
+        wait: Duration,
+        interrupt: &Interrupt,
         step_timeout: Duration,
     ) -> anyhow::Result<Self> {
         let topics = subs.topics;

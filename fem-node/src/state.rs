@@ -1,6 +1,7 @@
 //! The solver state that defines a run (serializable, for restarts and snapshots), kept apart from the per-step
 //! scratch memory (which is only workspace and is not serialized).
 
+use cosim_proto::validate::within_largest;
 use serde::{Deserialize, Serialize};
 
 use crate::element::ElementForces;
@@ -49,8 +50,8 @@ impl FemState {
             }
             // Within ±1e50, as every number of a message (`cosim_proto::validate::LARGEST`): a node at 1e300 m
             // passed, and the run failed at its first step as a collapsed element, naming no checkpoint.
-            let far = |v: f64| v.is_nan() || v.abs() > cosim_proto::validate::LARGEST;
-            if let Some(k) = values.iter().position(|p| far(p[0]) || far(p[1])) {
+            let held = |p: &[f64; 2]| within_largest(p[0]) && within_largest(p[1]);
+            if let Some(k) = values.iter().position(|p| !held(p)) {
                 return Err(format!(
                     "state.{field}[{k}] = {:?} is not finite within ±1e50",
                     values[k]

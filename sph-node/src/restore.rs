@@ -15,6 +15,7 @@
 use std::fmt::Debug;
 
 use cosim_proto::scene::BoxSpec;
+use cosim_proto::validate::within_largest;
 
 use crate::particles::{FluidState, WallParticles};
 
@@ -32,7 +33,7 @@ pub(crate) fn len<T>(field: &str, values: &[T], n: usize, what: &str) -> Check {
 
 /// Every entry of `values` is finite, within ±1e50.
 pub(crate) fn finite(field: &str, values: &[f64]) -> Check {
-    match values.iter().position(|&v| far(v)) {
+    match values.iter().position(|&v| !within_largest(v)) {
         None => Ok(()),
         Some(k) => Err(format!("{field}[{k}] = {} is not finite within ±1e50", values[k])),
     }
@@ -40,16 +41,13 @@ pub(crate) fn finite(field: &str, values: &[f64]) -> Check {
 
 /// Every vector of `values` is finite, within ±1e50.
 pub(crate) fn finite2(field: &str, values: &[[f64; 2]]) -> Check {
-    match values.iter().position(|v| far(v[0]) || far(v[1])) {
+    match values
+        .iter()
+        .position(|v| !(within_largest(v[0]) && within_largest(v[1])))
+    {
         None => Ok(()),
         Some(k) => Err(format!("{field}[{k}] = {:?} is not finite within ±1e50", values[k])),
     }
-}
-
-/// Not a number a state can hold: NaN, ±∞, or beyond ±1e50 (as every number of a message,
-/// `cosim_proto::validate::LARGEST`).
-fn far(v: f64) -> bool {
-    v.is_nan() || v.abs() > cosim_proto::validate::LARGEST
 }
 
 /// `saved` equals `want` bit for bit (same length, then every entry).

@@ -36,9 +36,12 @@ pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::R
             ));
         }
     }
-    if let (Some(link), Some(f)) = (&nodes.sph, &scene.fluid) {
+    if let Some(link) = &nodes.sph {
         let setup = link.setup();
         setup.validate().map_err(|e| unusable("sph-node", e))?;
+        let Some(f) = &scene.fluid else {
+            return Ok(());
+        };
         for (field, got, want) in [
             ("spacing", setup.spacing, f.spacing),
             ("h", setup.h, f.smoothing_ratio * f.spacing),
@@ -51,8 +54,6 @@ pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::R
                 ));
             }
         }
-    } else if let Some(link) = &nodes.sph {
-        link.setup().validate().map_err(|e| unusable("sph-node", e))?;
     }
     Ok(())
 }

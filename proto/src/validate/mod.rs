@@ -16,6 +16,12 @@ use crate::messages::{
 /// (`scene::MAGNITUDES`).
 pub const LARGEST: f64 = 1e50;
 
+/// Whether `v` is a number a state can hold: finite, and within ±[`LARGEST`]. The nodes' checkpoint checks use it
+/// too.
+pub fn within_largest(v: f64) -> bool {
+    v.is_finite() && v.abs() <= LARGEST
+}
+
 /// What makes a message unusable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -101,7 +107,7 @@ impl Check {
     /// surely as one that reports an infinity, and its squares and products would overflow the contact, the
     /// probes and the energy balance: a structure at ±1e308 m held the broker's contact grid in an endless loop).
     fn finite(self, field: &'static str, index: &[usize], v: f64) -> Result {
-        if v.is_finite() && v.abs() <= LARGEST {
+        if within_largest(v) {
             Ok(())
         } else {
             Err(Invalid {
@@ -225,7 +231,8 @@ impl FemMesh {
     /// 0.66 of the water's energy made; segments of zero length, the same (found 2026-12-06 by a sweep of hostile
     /// external nodes).
     fn check_boundary(&self, c: Check) -> Result {
-        let mut area = vec![0.0; self.solid_names.len()];
+        // Per solid: the signed area its segments enclose, and whether any segment starts on it.
+        let mut area = vec![(0.0, false); self.solid_names.len()];
         for (i, Segment { a, b }) in self.interface.iter().enumerate() {
             let (Some(pa), Some(pb)) = (self.nodes.get(*a as usize), self.nodes.get(*b as usize)) else {
                 continue;
@@ -238,20 +245,17 @@ impl FemMesh {
                     format!("a segment of zero length (both nodes at {pa:?})"),
                 ));
             }
-            let solid = self
-                .node_solid
-                .get(*a as usize)
-                .filter(|&&s| self.node_solid.get(*b as usize) == Some(&s));
-            if let Some(slot) = solid.and_then(|&s| area.get_mut(s as usize)) {
-                *slot += 0.5 * (pa[0] * pb[1] - pa[1] * pb[0]);
+            let solid = self.node_solid.get(*a as usize);
+            let Some(slot) = solid.and_then(|&s| area.get_mut(s as usize)) else {
+                continue;
+            };
+            slot.1 = true;
+            if self.node_solid.get(*b as usize) == solid {
+                slot.0 += 0.5 * (pa[0] * pb[1] - pa[1] * pb[0]);
             }
         }
-        for ((s, a), name) in area.iter().enumerate().zip(&self.solid_names) {
-            let has = self
-                .interface
-                .iter()
-                .any(|g| self.node_solid.get(g.a as usize) == Some(&(s as u32)));
-            if has && (a.is_nan() || *a <= 0.0) {
+        for ((s, &(a, has)), name) in area.iter().enumerate().zip(&self.solid_names) {
+            if has && (a.is_nan() || a <= 0.0) {
                 return Err(c.fail(
                     "interface",
                     &[],
