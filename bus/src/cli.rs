@@ -44,6 +44,7 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
     let args = Args::parse();
     let fail = |message: String, code: i32| -> ! {
         crate::log::say(&format!("{}: {}", topics.name, message.replace('\n', " ")));
+        crate::session::stop_runtime();
         std::process::exit(code)
     };
     if let Some(n) = args.threads {
@@ -60,7 +61,10 @@ pub fn node_main<C: NodeCore>(topics: NodeTopics, build: impl FnOnce(&Scene) -> 
         zenoh_config: args.zenoh_config,
     };
     match serve(&opts, topics, build) {
-        Ok(()) => std::process::exit(0),
+        Ok(()) => {
+            crate::session::stop_runtime();
+            std::process::exit(0)
+        }
         // A run id that is taken (`crate::claim`) is refused input, as for `cosim run`: exit code 2.
         Err(e) => fail(format!("{e:#}"), if crate::claim::is_refusal(&e) { 2 } else { 1 }),
     }

@@ -13,6 +13,7 @@ pub mod interrupt;
 pub mod link_loss;
 pub mod log;
 pub mod memory;
+pub mod refusals;
 pub mod seconds;
 pub mod serve;
 pub mod session;

@@ -137,14 +137,26 @@ pub fn serve<C: NodeCore>(
         false => crate::session::open_session_from(base, &opts.listen, &opts.connect, opts.timeout_ms),
     }
     .with_context(|| format!("cannot connect to {}", opts.connect.join(", ")))?;
+    let result = serve_open(&session, opts, topics, build);
+    crate::session::close(&session);
+    result
+}
+
+/// [`serve`] on an open session; every declaration on it is undone when this returns.
+fn serve_open<C: NodeCore>(
+    session: &Session,
+    opts: &NodeOptions,
+    topics: NodeTopics,
+    build: impl FnOnce(&Scene) -> Result<C, Failure>,
+) -> anyhow::Result<()> {
     let run = opts.run.as_str();
     // A run id claims its key space (`crate::claim`): a second node of this kind on a live run is refused before
     // it declares anything there, and reports nothing on the run's error topic (the run is fine without it).
-    crate::claim::ensure_free(&session, run, topics.alive, topics.name)?;
-    crate::claim::ensure_not_started(&session, run, topics.name)?;
+    crate::claim::ensure_free(session, run, topics.alive, topics.name)?;
+    crate::claim::ensure_not_started(session, run, topics.name)?;
     // Live status (`cosim inspect`), answered from the start; a failure is written on it before the exit.
     let board = Board::new(topics.name, run);
-    let _status = serve_status(&session, key(run, topics.status), board.clone())?;
+    let _status = serve_status(session, key(run, topics.status), board.clone())?;
     let errors = session
         .declare_publisher(key(run, topics.error))
         .congestion_control(CongestionControl::Block)
@@ -159,7 +171,7 @@ pub fn serve<C: NodeCore>(
         let _ = errors.put(Envelope::new(run, 0, 0.0, body).encode()).wait();
         reported.set(true);
     };
-    let result = serve_session(&session, opts, topics, build, &board, &report);
+    let result = serve_session(session, opts, topics, build, &board, &report);
     board.update(|s| {
         s.health = if result.is_ok() { "finished" } else { "failed" }.into();
         if let Err(e) = &result {
@@ -220,6 +232,7 @@ fn serve_session<C: NodeCore>(
     let mut core = build(&scene)?;
     // A restarted run: continue from the state the broker hands out, after the step it was saved at.
     let mut expected = 0u64;
+    let mut refusals = crate::refusals::Refusals::new("refused a command");
     let mut t = 0.0;
     if let Some(saved) = fetch_restore(session, run, topics, timeout)? {
         core.restore(&saved.body.data)
@@ -323,7 +336,7 @@ fn serve_session<C: NodeCore>(
                 // keeps its state and waits for the command it expects. Not reported as a failure: a stray
                 // message must not end the run; a broker whose commands this node cannot read times out on it
                 // and says so.
-                tracing::error!("refused a command: {e}");
+                refusals.note(&e);
                 board.update(|s| {
                     let n = s.extra.get("refused").and_then(|v| v.as_u64()).unwrap_or(0) + 1;
                     s.extra.insert("refused".into(), n.into());

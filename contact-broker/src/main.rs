@@ -83,7 +83,10 @@ struct Args {
 fn main() {
     // Its stderr is a log file in the output folder: a disk that fills up loses log lines, never the broker.
     cosim_bus::log::init();
-    if let Err(e) = run(Args::parse()) {
+    let result = run(Args::parse());
+    // Every session of the run is closed and dropped by now.
+    cosim_bus::session::stop_runtime();
+    if let Err(e) = result {
         cosim_bus::log::say(&format!("contact-broker: {}", format!("{e:#}").replace('\n', " ")));
         // A run id that is live already, a scene refused and an output folder of someone's own files are bad input
         // (exit 2, as `cosim run` gives for them).
@@ -146,6 +149,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         false => None,
     };
     let result = serve(&args, &setup, session.clone(), endpoints, &interrupt, recorder.as_ref());
+    cosim_bus::session::close(&session);
     // A run that failed before the coordinator wrote its summary (a node that never registered): say why there.
     if let Err(e) = &result {
         let written = std::fs::read_to_string(args.out.join(summary::FILE))

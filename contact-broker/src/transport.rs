@@ -21,6 +21,7 @@ use crate::link::{LinkError, NodeLink, Reply};
 use crate::recorder::Tap;
 use cosim_bus::interrupt::{Interrupt, REASON};
 use cosim_bus::link_loss;
+use cosim_bus::refusals::Refusals;
 use cosim_proto::trace::Kind;
 
 pub use cosim_bus::session::{
@@ -114,13 +115,33 @@ pub struct ZenohLink<S, T> {
     /// Ctrl-C or SIGTERM: a wait for an answer that still goes on
     /// [`STOP_WAIT`](cosim_bus::interrupt::STOP_WAIT) after it is given up.
     stop: Option<Interrupt>,
+    /// The node's messages refused so far, by kind.
+    refusals: LinkRefusals,
     _state: std::marker::PhantomData<T>,
+}
+
+/// The messages of one node refused, by kind, each logged in a few lines however many come
+/// ([`cosim_bus::refusals`]).
+struct LinkRefusals {
+    registrations: Refusals,
+    states: Refusals,
+    errors: Refusals,
+}
+
+impl LinkRefusals {
+    fn new(node: &str) -> Self {
+        Self {
+            registrations: Refusals::new(format!("{node}: refused a registration")),
+            states: Refusals::new(format!("{node}: refused a state message")),
+            errors: Refusals::new(format!("{node}: refused an error report")),
+        }
+    }
 }
 
 /// Turn an error sample into the error the run ends with; `None` for a message that does not decode as this
 /// run's error report (logged and dropped: a stray message must not end the run; a node that really fails also
 /// exits, and its liveliness token says so).
-fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkError> {
+fn node_error(sample: &Sample, run: &str, topics: &NodeTopics, refusals: &mut Refusals) -> Option<LinkError> {
     let node = topics.name.to_string();
     match Envelope::<NodeError>::decode(&sample.payload().to_bytes(), run, topics.error) {
         Ok(env) => {
@@ -131,7 +152,7 @@ fn node_error(sample: &Sample, run: &str, topics: &NodeTopics) -> Option<LinkErr
             })
         }
         Err(e) => {
-            tracing::error!("{node}: refused an error report: {e}");
+            refusals.note(&e);
             None
         }
     }
@@ -151,6 +172,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
         let deadline = Instant::now() + wait;
         // The last registration refused, kept over the whole wait: when no good one comes, it is the reason.
         let mut refused: Option<String> = None;
+        let mut refusals = LinkRefusals::new(topics.name);
         let (setup, registration) = loop {
             let got = subs
                 .setup
@@ -162,13 +184,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
                 match Envelope::<S>::decode(&bytes, run, topics.setup) {
                     Ok(env) => break (env.body, (env.step, bytes.into_owned())),
                     Err(e) => {
-                        tracing::error!("{}: refused a registration: {e}", topics.name);
+                        refusals.registrations.note(&e);
                         refused = Some(e.to_string());
                     }
                 }
             }
             if let Some(sample) = subs.error.try_recv().map_err(|e| anyhow::anyhow!("{e}"))? {
-                if let Some(e) = node_error(&sample, run, &topics) {
+                if let Some(e) = node_error(&sample, run, &topics, &mut refusals.errors) {
                     return Err(e.into());
                 }
             }
@@ -206,6 +228,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
             registration,
             tap: None,
             stop: None,
+            refusals,
             _state: std::marker::PhantomData,
         })
     }
@@ -239,7 +262,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
     }
 
     /// A failure the node reported or its death, if either happened.
-    fn check_node(&self) -> Result<(), LinkError> {
+    fn check_node(&mut self) -> Result<(), LinkError> {
         while let Ok(Some(sample)) = self.error.try_recv() {
             if let Some(e) = self.node_error(&sample) {
                 return Err(e);
@@ -280,8 +303,8 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> ZenohLink<S, T> {
 
     /// [`node_error`], recorded when it is this run's error report: under the step of the last command sent (a node
     /// reports its failure with step 0 in its envelope; it fails while it works on that command).
-    fn node_error(&self, sample: &Sample) -> Option<LinkError> {
-        let e = node_error(sample, &self.run, &self.topics)?;
+    fn node_error(&mut self, sample: &Sample) -> Option<LinkError> {
+        let e = node_error(sample, &self.run, &self.topics, &mut self.refusals.errors)?;
         if let Some(tap) = &self.tap {
             let step = self.last_command.as_ref().map_or(0, |(s, _, _)| *s);
             tap.record(Kind::Error, step, &sample.payload().to_bytes());
@@ -432,7 +455,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
                         }
                         Err(e) => {
                             let e: CodecError = e;
-                            tracing::error!("{}: refused a state message: {e}", self.topics.name);
+                            self.refusals.states.note(&e);
                             refused = Some(e.to_string());
                         }
                     }

@@ -71,6 +71,8 @@ enum FemSpoil {
     DropId,
     ShortX,
     X(usize, f64),
+    V(usize, f64),
+    Collapse,
     SnapshotShort,
     StressShort,
     NoSnapshot,
@@ -94,6 +96,7 @@ enum SphSpoil {
     ShortM,
     Mass(f64),
     X(f64),
+    V(f64),
     SnapshotShort,
     WallPShort,
     Rho(f64),
@@ -110,6 +113,12 @@ fn bad_number() -> impl Strategy<Value = f64> {
         Just(1e200),
         Just(-1e308)
     ]
+}
+
+/// A finite speed beyond ten times the scene's fastest wave speed (the plate's, 5,000 m/s: limit 50 km/s), which
+/// no run of it reaches (`cosim_proto::validate::speed_limit`).
+fn flung() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(1e20), Just(-1e6), Just(5.1e4)]
 }
 
 fn not_positive() -> impl Strategy<Value = f64> {
@@ -143,6 +152,8 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         Just(FemSpoil::DropId),
         Just(FemSpoil::ShortX),
         (any::<usize>(), bad_number()).prop_map(|(i, v)| FemSpoil::X(i, v)),
+        (any::<usize>(), prop_oneof![bad_number(), flung()]).prop_map(|(i, v)| FemSpoil::V(i, v)),
+        Just(FemSpoil::Collapse),
         Just(FemSpoil::SnapshotShort),
         Just(FemSpoil::StressShort),
         Just(FemSpoil::NoSnapshot),
@@ -164,6 +175,7 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         Just(SphSpoil::ShortM),
         not_positive().prop_map(SphSpoil::Mass),
         bad_number().prop_map(SphSpoil::X),
+        prop_oneof![bad_number(), flung()].prop_map(SphSpoil::V),
         Just(SphSpoil::SnapshotShort),
         Just(SphSpoil::WallPShort),
         not_positive().prop_map(SphSpoil::Rho),
@@ -269,6 +281,17 @@ fn spoil_fem(s: &mut FemState, how: &FemSpoil) -> Option<&'static str> {
             s.x[k][i % 2] = v;
             Some("x")
         }
+        FemSpoil::V(i, v) if !s.v.is_empty() => {
+            let k = pick(i, s.v.len());
+            s.v[k][i % 2] = v;
+            Some("v")
+        }
+        FemSpoil::Collapse if s.x.len() >= 2 => {
+            // Every interface node at one point (the sweep's `mesh_all_same`: the water fell through).
+            let first = s.x[0];
+            s.x.iter_mut().for_each(|x| *x = first);
+            Some("x")
+        }
         FemSpoil::SnapshotShort => s.snapshot.as_mut().map(|snap| {
             snap.x.pop();
             "x"
@@ -338,6 +361,10 @@ fn spoil_sph(s: &mut SphState, particles: u32, how: &SphSpoil) -> Option<&'stati
         SphSpoil::X(v) if !s.x.is_empty() => {
             s.x[0][1] = v;
             Some("x")
+        }
+        SphSpoil::V(v) if !s.v.is_empty() => {
+            s.v[0][1] = v;
+            Some("v")
         }
         SphSpoil::SnapshotShort => s.snapshot.as_mut().map(|snap| {
             snap.p.pop();
@@ -504,6 +531,59 @@ fn the_sweeps_cases_are_refused_naming_their_field() {
         assert_ne!(status, RunStatus::Ok, "{spoil:?}: {message}");
         assert!(message.contains(want), "{spoil:?}: `{want}` not in `{message}`");
     }
+}
+
+/// A state no run of the scene reaches, though its numbers are finite (found 2026-12-06 by a sweep of hostile
+/// external nodes, D12 and D1b: a structure reporting 1e20 m/s blew up the fluid node, which took the blame; one
+/// flung at 1e11 m/s made the coupling step crawl; half of an interface at one point ran on until the fluid blew up)
+/// ends the run `unstable` at the step it arrives, naming its sender, the field and the limit. A speed under the
+/// limit is taken.
+#[test]
+fn a_state_no_run_reaches_is_its_senders_blow_up() {
+    let cases = [
+        (
+            Spoil::Fem {
+                step: 3,
+                how: FemSpoil::V(0, 1e20),
+            },
+            &[
+                "fem-node: sent an unusable message: fem/state v[0] = [1e20, 0.0]: 1e20 m/s, faster than any run of \
+                 the scene moves (50000 m/s: 10 times its fastest wave speed)",
+            ][..],
+        ),
+        (
+            Spoil::Fem {
+                step: 4,
+                how: FemSpoil::Collapse,
+            },
+            &[
+                "fem-node: sent an unusable message: fem/state x = ",
+                "collapsed to a point",
+            ][..],
+        ),
+        (
+            Spoil::Sph {
+                step: 2,
+                how: SphSpoil::V(-1e11),
+            },
+            &[
+                "sph-node: sent an unusable message: sph/state v[0] = [",
+                "-100000000000.0]: 1e11 m/s, faster than any run of the scene moves",
+            ][..],
+        ),
+    ];
+    for (spoil, wants) in cases {
+        let (status, message, _) = run_spoilt(&spoil);
+        assert_eq!(status, RunStatus::Unstable, "{spoil:?}: {message}");
+        for want in wants {
+            assert!(message.contains(want), "{spoil:?}: `{want}` not in `{message}`");
+        }
+    }
+    let (status, message, _) = run_spoilt(&Spoil::Fem {
+        step: 3,
+        how: FemSpoil::V(0, 4.9e4),
+    });
+    assert_eq!(status, RunStatus::Ok, "{message}");
 }
 
 /// A stable step that collapses (found 2026-12-06 by a sweep of hostile external nodes: a fluid node reporting

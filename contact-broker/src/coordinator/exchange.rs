@@ -7,7 +7,7 @@ use anyhow::Context;
 
 use cosim_proto::messages::{FemState, SphState, StepCommand};
 use cosim_proto::scene::Scene;
-use cosim_proto::validate::{Asked, Invalid};
+use cosim_proto::validate::{speed_limit, Asked, Invalid};
 use cosim_proto::Num;
 
 use super::inputs::Nodes;
@@ -58,6 +58,36 @@ pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::R
     Ok(())
 }
 
+/// What every answer of the run is checked against besides its node's registration.
+pub(super) struct Expected {
+    /// The ids of the structure's interface nodes, which its answers report ([`cosim_proto::messages::FemMesh::interface_nodes`]).
+    interface_ids: Vec<u32>,
+    /// The fastest a node may report a particle or a node moving ([`speed_limit`]).
+    speed_limit: f64,
+}
+
+impl Expected {
+    /// From the scene and the registrations (checked).
+    pub fn new(scene: &Scene, nodes: &Nodes<'_>) -> Self {
+        let c0 = scene
+            .fluid
+            .as_ref()
+            .and_then(|f| sph_node::setup::sound_speed(f, scene.run.gravity).ok());
+        // A solid's bar wave speed √(E/ρ).
+        let solids = scene
+            .solids
+            .iter()
+            .map(|s| (s.material.youngs_modulus / s.material.density).sqrt());
+        Self {
+            interface_ids: nodes
+                .fem
+                .as_ref()
+                .map_or_else(Vec::new, |f| f.setup().interface_nodes()),
+            speed_limit: speed_limit(c0, solids),
+        }
+    }
+}
+
 /// A step command with nothing to correct and no region of interest.
 fn command(dt: f64, want_snapshot: bool) -> StepCommand {
     StepCommand {
@@ -99,7 +129,7 @@ pub(super) fn commands(
 /// `receive` (in this process).
 pub(super) fn exchange(
     nodes: &mut Nodes<'_>,
-    interface_ids: &[u32],
+    expected: &Expected,
     summary: &mut Summary,
     step: u64,
     t: f64,
@@ -109,7 +139,8 @@ pub(super) fn exchange(
     let asked = |cmd: &StepCommand| Asked {
         interface: cmd.want_interface,
         snapshot: cmd.want_snapshot,
-        interface_ids,
+        interface_ids: &expected.interface_ids,
+        speed_limit: expected.speed_limit,
     };
     let (fem_asked, sph_asked) = (asked(&fem_cmd), asked(&sph_cmd));
     let started = Instant::now();
@@ -194,11 +225,12 @@ fn unusable_because(node: &str, why: String) -> anyhow::Error {
     .into()
 }
 
-/// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state,
-/// ends `unstable`: the node blew up without noticing), naming the message, the field, the index and the value.
+/// A message from `node` whose contents cannot be used: the run fails (or, for a NaN or an infinity in a state, or a
+/// state no run of the scene reaches, ends `unstable`: the node blew up without noticing), naming the message, the
+/// field, the index and the value.
 fn unusable(node: &str, e: Invalid) -> LinkError {
     let (node, message) = (node.to_string(), format!("sent an unusable message: {e}"));
-    if e.is_non_finite() {
+    if e.blew_up() {
         LinkError::Unstable { node, message }
     } else {
         LinkError::Failed { node, message }

@@ -135,10 +135,7 @@ fn drive(
 ) -> anyhow::Result<()> {
     let s = &scene.scene;
     check_registrations(s, nodes)?;
-    let interface_ids = nodes
-        .fem
-        .as_ref()
-        .map_or_else(Vec::new, |f| f.setup().interface_nodes());
+    let expected = exchange::Expected::new(s, nodes);
     let mut outputs = Outputs::open(scene, nodes, &info.out, plan.restart.as_ref(), series)?;
     let mut contact = ContactPass::new(s, nodes)?;
     summary.reaction_relaxation = contact.relaxation().cloned();
@@ -150,7 +147,7 @@ fn drive(
         // The first sample, at t = 0.
         None => {
             let commands = contact.commands(0.0, true);
-            let mut round = exchange::exchange(nodes, &interface_ids, summary, 0, 0.0, commands)?;
+            let mut round = exchange::exchange(nodes, &expected, summary, 0, 0.0, commands)?;
             outputs.sample(
                 0.0,
                 false,
@@ -169,7 +166,7 @@ fn drive(
             clock.check_step(&step)?;
             // §3 steps 2–3: the commands out (with the last pass's corrections), the states in.
             let commands = contact.commands(step.dt, step.lands);
-            let mut round = exchange::exchange(nodes, &interface_ids, summary, clock.step, clock.t, commands)?;
+            let mut round = exchange::exchange(nodes, &expected, summary, clock.step, clock.t, commands)?;
             clock.advance(&step, &round, summary);
             // §3 step 4: contact on the states just reported; the corrections go out with the next command.
             contact.pass(&round, &step, clock.step, clock.t, summary)?;

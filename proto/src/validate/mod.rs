@@ -29,6 +29,9 @@ pub enum Kind {
     Inconsistent,
     /// A NaN, an infinity or a number beyond ±[`LARGEST`] where a state holds numbers: the sender blew up.
     NonFinite,
+    /// A state no run of the scene can reach, though its numbers are finite: a speed beyond [`Asked::speed_limit`],
+    /// a surface segment collapsed to a point. The sender blew up.
+    Implausible,
 }
 
 /// A message whose contents cannot be used: `fem/mesh cells[12][2] = 999: node id out of range (480 nodes)`.
@@ -53,6 +56,12 @@ impl Invalid {
     /// True when the message holds a NaN or an infinity where a state holds numbers: the sender blew up.
     pub fn is_non_finite(&self) -> bool {
         self.kind == Kind::NonFinite
+    }
+
+    /// True when the sender blew up: a number no state holds ([`Kind::NonFinite`]) or a state no run of the scene
+    /// reaches ([`Kind::Implausible`]). The run ends `unstable`, naming the sender.
+    pub fn blew_up(&self) -> bool {
+        matches!(self.kind, Kind::NonFinite | Kind::Implausible)
     }
 }
 
@@ -126,6 +135,27 @@ impl Check {
         Ok(())
     }
 
+    /// Every velocity of `vs` no faster than `limit` ([`Asked::speed_limit`]).
+    fn speeds(self, field: &'static str, vs: &[[f64; 2]], limit: f64) -> Result {
+        match vs.iter().position(|v| v[0].hypot(v[1]) > limit) {
+            None => Ok(()),
+            Some(i) => Err(Invalid {
+                kind: Kind::Implausible,
+                ..self.fail(
+                    field,
+                    &[i],
+                    format!("{:?}", vs[i]),
+                    format!(
+                        "{} m/s, faster than any run of the scene moves ({} m/s: {SPEED_LIMIT_FACTOR} times its \
+                         fastest wave speed)",
+                        crate::Num(significant(vs[i][0].hypot(vs[i][1]), 6)),
+                        crate::Num(limit)
+                    ),
+                )
+            }),
+        }
+    }
+
     fn values(self, field: &'static str, xs: &[f64]) -> Result {
         xs.iter()
             .enumerate()
@@ -166,6 +196,20 @@ impl Check {
         } else {
             Err(self.fail(field, index, id, format!("out of range ({count} {what})")))
         }
+    }
+}
+
+/// `v` rounded to `digits` significant digits, for a message.
+fn significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
+    let rounded = (v * scale).round() / scale;
+    if rounded.is_finite() {
+        rounded
+    } else {
+        v
     }
 }
 
@@ -281,6 +325,32 @@ pub struct Asked<'a> {
     pub snapshot: bool,
     /// For the structure: the ids of the mesh's interface nodes ([`FemMesh::interface_nodes`]).
     pub interface_ids: &'a [u32],
+    /// The fastest a particle or a node of the answer may move [m/s] ([`speed_limit`]; infinite: no limit).
+    pub speed_limit: f64,
+}
+
+/// How many times the scene's fastest wave speed a state may move at most ([`speed_limit`]).
+pub const SPEED_LIMIT_FACTOR: f64 = 10.0;
+
+/// The fastest a fluid particle or a structure node of a run may move: [`SPEED_LIMIT_FACTOR`] times the fastest
+/// wave speed of the scene, the fluid's sound speed `c0` (where it has one) or a solid's bar wave speed √(E/ρ)
+/// (`solid_wave_speeds`). Nothing a run can reach comes near it: a weakly compressible fluid's model holds below a
+/// tenth of `c0` (`DESIGN.md` §4.2, c0 ≥ 10 v_max), and a node moving at its solid's wave speed strains it by order
+/// one. A node that reports more has blown up, though its numbers are finite: found 2026-12-06 by a sweep of
+/// hostile external nodes, a structure reporting 1e20 m/s, or one whose spring flung it at 1e11 m/s, blew up the
+/// fluid node, which took the blame, or made the coupling step crawl (1e5 steps to reach t = 0.0006 s). Infinite
+/// where the scene gives no wave speed.
+pub fn speed_limit(c0: Option<f64>, solid_wave_speeds: impl IntoIterator<Item = f64>) -> f64 {
+    let fastest = solid_wave_speeds
+        .into_iter()
+        .chain(c0)
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .fold(0.0, f64::max);
+    if fastest > 0.0 {
+        SPEED_LIMIT_FACTOR * fastest
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl FemState {
@@ -303,19 +373,44 @@ impl FemState {
         c.len("v", self.v.len(), self.ids.len(), "id")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
+        c.speeds("v", &self.v, asked.speed_limit)?;
+        self.check_segments(c, mesh)?;
         c.step("dt_stable", self.dt_stable)?;
         c.seconds("compute_seconds", self.compute_seconds)?;
         match &self.snapshot {
-            Some(s) => s.validate(mesh),
+            Some(s) => s.validate(mesh, asked.speed_limit),
             None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
             None => Ok(()),
         }
     }
+
+    /// No interface segment of the reported state (ids already checked against the mesh's interface nodes, which
+    /// are ascending) has collapsed to a point: the contact takes its normal from it. An outside node that put half
+    /// its interface nodes at one point ran on until the fluid node blew up and took the blame (found 2026-12-06).
+    fn check_segments(&self, c: Check, mesh: &FemMesh) -> Result {
+        let at = |id: u32| self.ids.binary_search(&id).ok().and_then(|k| self.x.get(k));
+        for (i, Segment { a, b }) in mesh.interface.iter().enumerate() {
+            if let (Some(pa), Some(pb)) = (at(*a), at(*b)) {
+                if pa == pb {
+                    return Err(Invalid {
+                        kind: Kind::Implausible,
+                        ..c.fail(
+                            "x",
+                            &[],
+                            format!("{pa:?} for nodes {a} and {b}"),
+                            format!("interface segment {i} collapsed to a point"),
+                        )
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 impl FemSnapshot {
-    /// Check a structure snapshot against the mesh it is of.
-    pub fn validate(&self, mesh: &FemMesh) -> Result {
+    /// Check a structure snapshot against the mesh it is of, its nodes no faster than `speed_limit`.
+    pub fn validate(&self, mesh: &FemMesh, speed_limit: f64) -> Result {
         let c = Check("fem/state snapshot");
         c.len("x", self.x.len(), mesh.nodes.len(), "node")?;
         c.len("v", self.v.len(), mesh.nodes.len(), "node")?;
@@ -323,6 +418,7 @@ impl FemSnapshot {
         c.len("energies", self.energies.len(), mesh.solid_names.len(), "solid")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
+        c.speeds("v", &self.v, speed_limit)?;
         c.points("stress", &self.stress)?;
         let energies: Vec<[f64; 3]> = self
             .energies
@@ -363,13 +459,14 @@ impl SphState {
         c.len("m", self.m.len(), self.ids.len(), "id")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
+        c.speeds("v", &self.v, asked.speed_limit)?;
         for (k, m) in self.m.iter().enumerate() {
             c.positive("m", &[k], *m)?;
         }
         c.step("dt_stable", self.dt_stable)?;
         c.seconds("compute_seconds", self.compute_seconds)?;
         match &self.snapshot {
-            Some(s) => s.validate(setup),
+            Some(s) => s.validate(setup, asked.speed_limit),
             None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
             None => Ok(()),
         }
@@ -377,8 +474,8 @@ impl SphState {
 }
 
 impl SphSnapshot {
-    /// Check a fluid snapshot against the registration it belongs to.
-    pub fn validate(&self, setup: &SphSetup) -> Result {
+    /// Check a fluid snapshot against the registration it belongs to, its particles no faster than `speed_limit`.
+    pub fn validate(&self, setup: &SphSetup, speed_limit: f64) -> Result {
         let c = Check("sph/state snapshot");
         let n = setup.particles as usize;
         for (field, len) in [
@@ -400,6 +497,7 @@ impl SphSnapshot {
         }
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
+        c.speeds("v", &self.v, speed_limit)?;
         c.values("p", &self.p)?;
         c.values("wall_p", &self.wall_p)?;
         for (k, rho) in self.rho.iter().enumerate() {

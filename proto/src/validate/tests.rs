@@ -91,6 +91,7 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
         interface: true,
         snapshot: false,
         interface_ids: &ids,
+        speed_limit: f64::INFINITY,
     };
     let state = FemState {
         ids: ids.clone(),
@@ -144,6 +145,35 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
     );
     slow.compute_seconds = 1e9;
     assert_eq!(slow.validate(&m, asked), Ok(()));
+    // A speed no run of the scene reaches (D12 of the sweep: 1e20 m/s blew up the fluid node, which took the blame)
+    // is the sender's blow-up, finite or not; a speed at the limit passes.
+    let limited = Asked {
+        speed_limit: 100.0,
+        ..asked
+    };
+    let mut flung = state.clone();
+    flung.v[2] = [60.0, -80.0];
+    assert_eq!(flung.validate(&m, limited), Ok(()));
+    flung.v[2] = [60.0, -80.001];
+    let e = flung.validate(&m, limited).unwrap_err();
+    assert!(e.blew_up() && !e.is_non_finite());
+    assert_eq!(
+        e.to_string(),
+        "fem/state v[2] = [60.0, -80.001]: 100.001 m/s, faster than any run of the scene moves (100 m/s: 10 times \
+         its fastest wave speed)"
+    );
+    // An interface segment collapsed to a point (D12c: half the interface nodes at one point).
+    let mut collapsed = state.clone();
+    collapsed.x[1] = collapsed.x[0];
+    let e = collapsed.validate(&m, asked).unwrap_err();
+    assert!(e.blew_up());
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "fem/state x = {:?} for nodes 0 and 1: interface segment 0 collapsed to a point",
+            state.x[0]
+        )
+    );
     let no_snapshot = Asked {
         snapshot: true,
         ..asked
@@ -169,6 +199,7 @@ fn fluid_ids_must_be_in_range_ascending_and_once() {
         interface: true,
         snapshot: false,
         interface_ids: &[],
+        speed_limit: f64::INFINITY,
     };
     let state = |ids: Vec<u32>| SphState {
         x: vec![[0.0; 2]; ids.len()],
@@ -188,6 +219,17 @@ fn fluid_ids_must_be_in_range_ascending_and_once() {
     assert_eq!(
         state(vec![2, 2]).validate(&setup, asked).unwrap_err().to_string(),
         "sph/state ids[1] = 2: ids must be ascending, each once"
+    );
+    let mut fast = state(vec![1]);
+    fast.v[0] = [0.0, -1e20];
+    let limited = Asked {
+        speed_limit: 240.0,
+        ..asked
+    };
+    assert_eq!(
+        fast.validate(&setup, limited).unwrap_err().to_string(),
+        "sph/state v[0] = [0.0, -1e20]: 1e20 m/s, faster than any run of the scene moves (240 m/s: 10 times its \
+         fastest wave speed)"
     );
     let mut zero_dt = state(vec![1]);
     zero_dt.dt_stable = 0.0;
@@ -272,4 +314,14 @@ fn a_correction_s_face_is_checked() {
         ..good
     };
     assert!(with(nan_normal).validate("broker/sph", 2, 1e-4).is_err());
+}
+
+/// The limit is ten times the fastest of the fluid's sound speed and the solids' bar wave speeds; none without one.
+#[test]
+fn the_speed_limit_is_ten_times_the_fastest_wave_speed() {
+    assert_eq!(speed_limit(Some(24.0), [104.0, 3.0]), 1040.0);
+    assert_eq!(speed_limit(Some(24.0), []), 240.0);
+    assert_eq!(speed_limit(None, [5000.0]), 50000.0);
+    assert_eq!(speed_limit(None, [f64::NAN]), f64::INFINITY);
+    assert_eq!(speed_limit(None, []), f64::INFINITY);
 }
