@@ -63,6 +63,7 @@ enum MeshSpoil {
     NoSolids,
     NoInterface,
     HugeCellSolid(usize),
+    Scale(f64),
 }
 
 #[derive(Clone, Debug)]
@@ -146,6 +147,7 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         Just(MeshSpoil::NoSolids),
         Just(MeshSpoil::NoInterface),
         (1usize..200_000).prop_map(MeshSpoil::HugeCellSolid),
+        prop_oneof![Just(20.0), Just(1e6)].prop_map(MeshSpoil::Scale),
     ];
     let fem = prop_oneof![
         (any::<usize>(), any::<u32>()).prop_map(|(i, v)| FemSpoil::Id(i, v)),
@@ -257,6 +259,10 @@ fn spoil_mesh(m: &mut FemMesh, how: &MeshSpoil) -> &'static str {
         MeshSpoil::HugeCellSolid(k) => {
             m.cell_solid.extend(std::iter::repeat_n(0, k));
             "cell_solid"
+        }
+        MeshSpoil::Scale(f) => {
+            m.nodes.iter_mut().for_each(|x| *x = x.map(|c| c * f));
+            "interface"
         }
     }
 }
@@ -507,6 +513,12 @@ fn the_sweeps_cases_are_refused_naming_their_field() {
             "sph/setup density = 1000000: the scene gives 1000",
         ),
         (Spoil::Mesh(MeshSpoil::NoInterface), "fem/mesh interface = 0 entries"),
+        // A plate registered a million times its size (`particle_particle` took 7.7 GB laying points along it).
+        (
+            Spoil::Mesh(MeshSpoil::Scale(1e6)),
+            "fem/mesh interface = 44 segments 2100000 m long together: the scene's solids have 2.1 m of surface (at \
+             most 10 times that)",
+        ),
         (
             Spoil::Mesh(MeshSpoil::Mass(0, 1.7e308)),
             "fem/mesh masses[0] = 1.7e308: must be a number > 0 and ≤ 1e50",

@@ -35,6 +35,9 @@ pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::R
                 "fem/mesh interface = 0 entries: a structure coupled to a fluid needs its boundary segments".into(),
             ));
         }
+        if nodes.sph.is_some() {
+            check_surface(scene, link.setup())?;
+        }
     }
     if let Some(link) = &nodes.sph {
         let setup = link.setup();
@@ -86,6 +89,41 @@ impl Expected {
             speed_limit: speed_limit(c0, solids),
         }
     }
+}
+
+/// How many times the scene's solids' perimeter a coupled structure's registered surface may be long.
+const SURFACE_FACTOR: f64 = 10.0;
+
+/// A coupled structure's surface is the scene's, give or take: its segments at most [`SURFACE_FACTOR`] times as long
+/// as the perimeters of the scene's solids together. An outside node may mesh the solids its own way, but not make
+/// them another size: `particle_particle` lays a point every fluid spacing along the surface, and a plate registered
+/// 1e6 m long took 7.7 GB and 3 s a coupling step (found 2026-12-06 by the sweep of hostile external nodes, D3).
+fn check_surface(scene: &Scene, mesh: &cosim_proto::messages::FemMesh) -> anyhow::Result<()> {
+    let perimeter: f64 = scene
+        .solids
+        .iter()
+        .map(|s| 2.0 * ((s.max[0] - s.min[0]) + (s.max[1] - s.min[1])))
+        .sum();
+    // Ids were checked with the mesh.
+    let length: f64 = mesh
+        .interface
+        .iter()
+        .filter_map(|s| Some((mesh.nodes.get(s.a as usize)?, mesh.nodes.get(s.b as usize)?)))
+        .map(|(a, b)| (b[0] - a[0]).hypot(b[1] - a[1]))
+        .sum();
+    if length > SURFACE_FACTOR * perimeter {
+        return Err(unusable_because(
+            "fem-node",
+            format!(
+                "fem/mesh interface = {} segments {} m long together: the scene's solids have {} m of surface (at \
+                 most {SURFACE_FACTOR} times that)",
+                mesh.interface.len(),
+                Num(length),
+                Num(perimeter)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A step command with nothing to correct and no region of interest.
