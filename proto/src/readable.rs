@@ -22,6 +22,16 @@ impl fmt::Display for Num {
     }
 }
 
+/// `x` rounded to `digits` significant digits, for a message whose value is a sum or a norm (2000000.0999999999 m
+/// reads 2000000.1 m at 8 digits); as it is for 0, ±∞ and NaN.
+pub fn significant(x: f64, digits: usize) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    // Rust's own decimal rounding, which cannot overflow or leave a last-bit error as a scaling would.
+    format!("{x:.*e}", digits.saturating_sub(1)).parse().unwrap_or(x)
+}
+
 /// A node's message as one printable line of at most 2,000 characters: control characters (a carriage return, a
 /// terminal's escape sequences) became spaces, so that what a node says cannot hide which node said it or rewrite
 /// the terminal (found 2026-12-06).
@@ -40,7 +50,17 @@ pub fn one_line(message: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{one_line, Num};
+    use super::{one_line, significant, Num};
+
+    #[test]
+    fn a_sum_reads_with_its_significant_digits() {
+        assert_eq!(Num(significant(2000000.0999999999, 6)).to_string(), "2000000");
+        assert_eq!(Num(significant(100.00080000179999, 6)).to_string(), "100.001");
+        assert_eq!(Num(significant(-2.2222222223803344e8, 6)).to_string(), "-2.22222e8");
+        assert_eq!(significant(1.7e308, 6), 1.7e308);
+        assert!(significant(f64::NAN, 6).is_nan());
+        assert_eq!(significant(0.0, 6), 0.0);
+    }
 
     #[test]
     fn a_nodes_message_is_one_printable_line() {

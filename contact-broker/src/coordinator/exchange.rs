@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::Context;
 
 use cosim_proto::messages::{FemState, SphState, StepCommand};
+use cosim_proto::readable::significant;
 use cosim_proto::scene::Scene;
 use cosim_proto::validate::{speed_limit, Asked, Invalid};
 use cosim_proto::Num;
@@ -118,8 +119,8 @@ fn check_surface(scene: &Scene, mesh: &cosim_proto::messages::FemMesh) -> anyhow
                 "fem/mesh interface = {} segments {} m long together: the scene's solids have {} m of surface (at \
                  most {SURFACE_FACTOR} times that)",
                 mesh.interface.len(),
-                Num(length),
-                Num(perimeter)
+                Num(significant(length, 6)),
+                Num(significant(perimeter, 6))
             ),
         ));
     }

@@ -148,7 +148,7 @@ impl Check {
                     format!(
                         "{} m/s, faster than any run of the scene moves ({} m/s: {SPEED_LIMIT_FACTOR} times its \
                          fastest wave speed)",
-                        crate::Num(significant(vs[i][0].hypot(vs[i][1]), 6)),
+                        crate::Num(crate::readable::significant(vs[i][0].hypot(vs[i][1]), 6)),
                         crate::Num(limit)
                     ),
                 )
@@ -196,20 +196,6 @@ impl Check {
         } else {
             Err(self.fail(field, index, id, format!("out of range ({count} {what})")))
         }
-    }
-}
-
-/// `v` rounded to `digits` significant digits, for a message.
-fn significant(v: f64, digits: i32) -> f64 {
-    if v == 0.0 || !v.is_finite() {
-        return v;
-    }
-    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
-    let rounded = (v * scale).round() / scale;
-    if rounded.is_finite() {
-        rounded
-    } else {
-        v
     }
 }
 
