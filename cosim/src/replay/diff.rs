@@ -23,7 +23,8 @@ pub struct Tolerance {
 pub struct Divergence {
     /// The field (dotted path of names; `envelope.t` for the header).
     pub field: String,
-    /// The index inside it (`[12][1]`), empty for a scalar.
+    /// The index inside it (`[12][1]`), empty for a scalar; what else of it differs (`[3] (length)`, `(length)`,
+    /// `byte 40`).
     pub index: String,
     /// Recorded value.
     pub recorded: String,
@@ -33,9 +34,12 @@ pub struct Divergence {
 
 impl fmt::Display for Divergence {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let index = match self.index.is_empty() {
-            true => String::new(),
-            false => format!(" index {}", self.index),
+        // "index" before an index proper only: a top-level array's length read "field corrections index  (length)"
+        // (found 2026-12-06 by the sweep of damaged traces, D25).
+        let index = match self.index.as_str() {
+            "" => String::new(),
+            i if i.starts_with('[') => format!(" index {i}"),
+            other => format!(" {other}"),
         };
         write!(
             f,
@@ -140,7 +144,11 @@ fn walk(field: &str, index: &str, a: &Value, b: &Value, tol: Option<Tolerance>) 
         }
         (Value::Array(x), Value::Array(y)) => {
             if x.len() != y.len() {
-                return diverged(field, &format!("{index} (length)"), x.len(), y.len());
+                let at = match index.is_empty() {
+                    true => "(length)".to_string(),
+                    false => format!("{index} (length)"),
+                };
+                return diverged(field, &at, x.len(), y.len());
             }
             x.iter()
                 .zip(y)
@@ -228,6 +236,25 @@ mod tests {
             compare::<StepCommand>("c", &enc("a", cmd(1.0)), &enc("a", cmd(off)), tol, |_| {}).unwrap(),
             None
         );
+    }
+
+    /// A top-level list of another length: one space, no "index" with nothing after it ("field corrections index
+    /// (length)" with two spaces before, D25 of the 2026-12-06 sweep); a nested one keeps its index.
+    #[test]
+    fn a_length_is_named_without_an_empty_index() {
+        let mut two = cmd(1.0);
+        two.corrections.push(two.corrections[0]);
+        let d = compare::<StepCommand>("c", &enc("a", cmd(1.0)), &enc("a", two), None, |_| {})
+            .unwrap()
+            .unwrap();
+        assert_eq!(d.to_string(), "field corrections (length): recorded 1, replayed 2");
+        let nested = Divergence {
+            field: "x".into(),
+            index: "[3] (length)".into(),
+            recorded: "2".into(),
+            replayed: "3".into(),
+        };
+        assert_eq!(nested.to_string(), "field x index [3] (length): recorded 2, replayed 3");
     }
 
     #[test]
