@@ -25,14 +25,15 @@ pub struct Envelope<B> {
 #[derive(Debug, thiserror::Error)]
 pub enum CodecError {
     /// The bytes do not decode as the expected message.
-    #[error("malformed {what} message ({len} bytes): {source}")]
+    #[error("malformed {what} message ({len} bytes): {error}")]
     Malformed {
         /// Expected message type.
         what: &'static str,
         /// Payload length.
         len: usize,
-        /// Decoder error.
-        source: bincode::Error,
+        /// Decoder error. In the message, not a `source`: an error chain printed whole (`{:#}`) said bincode's
+        /// reason twice, "string is not valid utf8: …: string is not valid utf8: …" (the 2026-12-06 sweep, D25).
+        error: bincode::Error,
     },
     /// Another protocol version.
     #[error("{what} message speaks protocol version {got}, this build speaks {PROTOCOL_VERSION}")]
@@ -152,10 +153,10 @@ impl<B: DeserializeOwned> Envelope<B> {
                 return Err(CodecError::Version { what, got: version });
             }
         }
-        let env: Envelope<B> = options().deserialize(bytes).map_err(|source| CodecError::Malformed {
+        let env: Envelope<B> = options().deserialize(bytes).map_err(|error| CodecError::Malformed {
             what,
             len: bytes.len(),
-            source,
+            error,
         })?;
         if env.run != run {
             return Err(CodecError::Run {

@@ -169,6 +169,36 @@ fn invalid_bool_option_tag_and_utf8_are_malformed() {
     assert_malformed(Envelope::<StepCommand>::decode(&bad_utf8, "r1", "test"), n);
 }
 
+/// The whole error chain, as `{:#}` prints it (what the broker logs and a summary says).
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut at = e.source();
+    while let Some(s) = at {
+        text += &format!(": {s}");
+        at = s.source();
+    }
+    text
+}
+
+/// Bincode's reason said once: "malformed fem/mesh … string is not valid utf8: …: string is not valid utf8: …"
+/// (found 2026-12-06 by the sweep of hostile external nodes, D25).
+#[test]
+fn a_malformed_message_says_its_reason_once() {
+    let mut bad_utf8 = step_command().encode();
+    bad_utf8[12] = 0xff;
+    let n = bad_utf8.len();
+    let err = Envelope::<StepCommand>::decode(&bad_utf8, "r1", "test").unwrap_err();
+    let text = chain(&err);
+    assert!(
+        text.starts_with(&format!(
+            "malformed test message ({n} bytes): string is not valid utf8: "
+        )),
+        "{text}"
+    );
+    assert_eq!(text.matches("not valid utf8").count(), 1, "{text}");
+    assert_eq!(text.matches("invalid utf-8").count(), 1, "{text}");
+}
+
 #[test]
 fn huge_length_prefixes_are_malformed_without_allocating() {
     // corrections count at offset 38 (header 30 + dt 8) claims 2^62 items; run length claims 2^40 bytes.
