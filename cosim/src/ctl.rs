@@ -48,7 +48,9 @@ pub fn ctl(args: &CtlArgs) -> anyhow::Result<ExitCode> {
         args.steps.is_none() || args.action == CtlAction::Step,
         "a number of steps goes with `step` only"
     );
-    anyhow::ensure!(args.steps != Some(0), "step: give at least 1 step");
+    if let Some(why) = args.steps.and_then(contact_broker::coordinator::pause::refuse_steps) {
+        anyhow::bail!(why);
+    }
     let (session, connect) = join(&args.id, &args.join)?;
     let timeout = cosim_bus::seconds::wait(args.join.timeout);
     let reply = match ask(&session, &args.id, command, timeout) {

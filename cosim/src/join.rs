@@ -29,9 +29,14 @@ pub struct JoinArgs {
     pub timeout: f64,
 }
 
-/// Open a session on run `id`'s network; also the endpoint joined. `Err` (exit 2) for a run not found here without
-/// `--connect`, a bad config file, or a run that cannot be reached.
+/// Open a session on run `id`'s network; also the endpoint joined. `Err` (exit 2) for an id no run can have, a run
+/// not found here without `--connect`, a bad config file, or a run that cannot be reached.
 pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
+    // Said as such, not as "not running on this machine" (found 2026-12-06 by the sweep of debug tools, D25).
+    anyhow::ensure!(
+        cosim_proto::keys::valid_run_id(id),
+        "`{id}` is not a valid run id: a run id is 1–64 letters, digits, - and _"
+    );
     let (connect, client, zenoh_config) = match &how.connect {
         Some(c) => (c.clone(), how.client, how.zenoh_config.clone()),
         None => match registry::lookup(id) {

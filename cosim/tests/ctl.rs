@@ -354,3 +354,34 @@ fn a_closed_endpoint_is_said_at_once() {
         );
     }
 }
+
+/// A run id no run can have is said as such, exit 2, before any look-up (found 2026-12-06 by the sweep of debug
+/// tools, D25: `cosim ctl 'bad/id' status` said "not running on this machine").
+#[test]
+fn an_invalid_run_id_is_said_as_such() {
+    for args in [
+        vec!["ctl", "bad/id", "status"],
+        vec!["inspect", "bad/id", "--once"],
+        vec!["snapshot", "bad/id", "--out", "/tmp/cosim-invalid-id-snapshot"],
+    ] {
+        let (code, _, text) = cosim_json(&args);
+        assert_eq!(code, 2, "{args:?}: {text}");
+        assert_eq!(
+            text.trim(),
+            "cosim: `bad/id` is not a valid run id: a run id is 1–64 letters, digits, - and _",
+            "{args:?}"
+        );
+    }
+}
+
+/// A step count no run reaches is refused before anything is asked, exit 2 (found 2026-12-06 by the sweep of debug
+/// tools, D25: `step 18446744073709551615` resumed the run, then said it "did not pause again").
+#[test]
+fn a_step_count_no_run_reaches_is_refused() {
+    let (code, _, text) = cosim_json(&["ctl", "nowhere", "step", "18446744073709551615"]);
+    assert_eq!(code, 2, "{text}");
+    assert_eq!(
+        text.trim(),
+        "cosim: step 18446744073709551615: more than the 1e12 steps a run may take"
+    );
+}

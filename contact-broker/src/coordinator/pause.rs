@@ -16,6 +16,18 @@ use crate::link::LinkError;
 /// How long one wait for a command lasts while paused (the controller checks its own stop signals in between).
 pub const PAUSED_POLL: Duration = Duration::from_millis(50);
 
+/// Why `step N` cannot be taken: no step, or more than any run may take ([`crate::step_budget::MAX_STEPS`]; `cosim
+/// ctl RUN step 18446744073709551615` resumed the run and then said it "did not pause again", found 2026-12-06 by
+/// the sweep of debug tools, D25). `cosim ctl` says it before it asks; the broker refuses it from any other client.
+pub fn refuse_steps(steps: u64) -> Option<String> {
+    use crate::step_budget::MAX_STEPS;
+    match steps {
+        0 => Some("step: give at least 1 step".into()),
+        n if n as f64 > MAX_STEPS => Some(format!("step {n}: more than the {MAX_STEPS:e} steps a run may take")),
+        _ => None,
+    }
+}
+
 /// The run between two steps, as a paused run shows it.
 pub struct Halt<'a, 'n> {
     /// Last coupling step done.
@@ -197,12 +209,14 @@ impl<'c> Debugger<'c> {
                     halt.paused.clear();
                     halt.reply(true, "resumed")
                 }
-                ControlCommand::Step { steps: 0 } => halt.reply(false, "step: give at least 1 step"),
-                ControlCommand::Step { steps } => {
-                    self.mode = Mode::Stepping(steps, steps);
-                    halt.paused.clear();
-                    halt.reply(true, format!("taking {steps} step(s)"))
-                }
+                ControlCommand::Step { steps } => match refuse_steps(steps) {
+                    Some(why) => halt.reply(false, why),
+                    None => {
+                        self.mode = Mode::Stepping(steps, steps);
+                        halt.paused.clear();
+                        halt.reply(true, format!("taking {steps} step(s)"))
+                    }
+                },
                 ControlCommand::Status => halt.reply(true, "status"),
                 ControlCommand::Stop => {
                     self.controller.answer(halt.reply(true, "stopping"));
@@ -316,6 +330,7 @@ mod tests {
             commands: [
                 ControlCommand::Pause,
                 ControlCommand::Step { steps: 0 },
+                ControlCommand::Step { steps: u64::MAX },
                 ControlCommand::Status,
                 ControlCommand::Stop,
             ]
@@ -325,7 +340,15 @@ mod tests {
         let mut debugger = Debugger::new(None, &mut script);
         assert_eq!(drive(&mut debugger, 10), Some(1));
         let oks: Vec<bool> = script.answers.iter().map(|a| a.ok).collect();
-        assert_eq!(oks, [true, false, true, true]);
+        assert_eq!(oks, [true, false, false, true, true]);
+        assert_eq!(
+            script.answers[2].message,
+            "step 18446744073709551615: more than the 1e12 steps a run may take"
+        );
+        assert_eq!(
+            script.answers[2].paused,
+            "paused at step 1: paused by `cosim ctl pause`"
+        );
         assert_eq!(script.shown, ["paused at step 1: paused by `cosim ctl pause`"]);
     }
 
