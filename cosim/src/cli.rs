@@ -305,8 +305,9 @@ pub struct ReplayArgs {
     /// The node to run again.
     #[arg(long, value_enum)]
     pub node: ExternalNode,
-    /// Run this program in the node's place instead of the built-in one: a command line, split as the shell does
-    /// (run by `sh`), to which `--run ID --connect ENDPOINT` are appended.
+    /// Run this program in the node's place instead of the built-in one: a shell command line, run as `sh -c
+    /// 'COMMAND "$@"'` with `--run ID --connect ENDPOINT` as `"$@"`, so they go to its last simple command, which must
+    /// be the node: `python3 node.py`, `cd dir && ./node`, `env X=1 ./node` (no trailing `;`, `&` or `# comment`).
     #[arg(long, value_name = "COMMAND")]
     pub exec: Option<String>,
     /// Compare numbers within this relative tolerance instead of byte for byte: |replayed − recorded| ≤ atol +

@@ -126,6 +126,10 @@ fn a_wrong_node_is_named_at_its_step_field_and_index() {
     // One ulp is within any tolerance worth the name: the per-field comparison lets it through.
     let lenient = replay(&[&trace, "--node", "fem", "--exec", &wrong, "--rtol", "1e-12"]);
     assert_eq!(matched(&lenient), 315);
+    // A compound line runs as the shell runs it, the arguments going to the node at its end: it was `exec cd … &&
+    // ./fem-node "$@"`, and the node never started (found 2026-12-06 by the sweep of hostile external nodes, D25).
+    let compound = format!("cd '{}' && ./fem-node", bin_dir().display());
+    assert_eq!(matched(&replay(&[&trace, "--node", "fem", "--exec", &compound])), 315);
 }
 
 #[test]
@@ -335,6 +339,7 @@ fn a_damaged_trace_or_an_unusable_answer_is_not_a_match() {
     );
     // The other node's part of the same file is whole.
     assert_eq!(matched(&replay(&[&dir_s, "--node", "sph"])), 315);
+
     // A device is not a trace, and is not read (/dev/zero was read until 6.5 GB were taken).
     let zero = replay(&["/dev/zero", "--node", "fem"]);
     assert_eq!(zero.status.code(), Some(2), "{}", text(&zero));

@@ -366,7 +366,7 @@ fn spawn(args: &ReplayArgs, run: &str, endpoint: &str, log: &Path) -> anyhow::Re
     let mut cmd = match &args.exec {
         Some(line) => {
             let mut c = Command::new("sh");
-            c.arg("-c").arg(format!("exec {line} \"$@\"")).arg("sh");
+            c.arg("-c").arg(exec_script(line)).arg("sh");
             c
         }
         None => Command::new(crate::launch::find_program(args.node.program())?),
@@ -379,6 +379,15 @@ fn spawn(args: &ReplayArgs, run: &str, endpoint: &str, log: &Path) -> anyhow::Re
         .stderr(log_file)
         .spawn()
         .with_context(|| format!("cannot start {}", args.exec.as_deref().unwrap_or(args.node.program())))
+}
+
+/// What `sh -c` runs for `--exec COMMAND`, the arguments given after it as `"$@"`: `COMMAND "$@"`, so they go to its
+/// last simple command, and a compound line runs as the shell runs it (`cd dir && ./node` starts `./node --run …` in
+/// `dir`). It was `exec COMMAND "$@"`, which made that line `exec cd dir && …`: `exec cd` failed and the node never
+/// started (found 2026-12-06 by the sweep of hostile external nodes, D25). Without `exec` the shell may stay as the
+/// node's parent; the node leads its process group either way, which the replay ends whole ([`Node`]).
+fn exec_script(line: &str) -> String {
+    format!("{line} \"$@\"")
 }
 
 /// The last non-empty line of the node's log.
