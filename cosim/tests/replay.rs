@@ -61,6 +61,22 @@ fn matched(out: &Output) -> u64 {
         .unwrap_or_else(|| panic!("no `matched N steps` in {stdout:?}"))
 }
 
+/// `full` (a trace whose records are `records`) with its records in `order` (indices into `records`).
+fn reordered(full: &[u8], records: &[cosim_proto::trace::Record], order: &[usize]) -> Vec<u8> {
+    let mut spans = Vec::with_capacity(records.len());
+    let mut at = cosim_proto::trace::HEADER_BYTES;
+    for r in records {
+        let len = 8 + 10 + r.payload.len();
+        spans.push(at..at + len);
+        at += len;
+    }
+    let mut out = full[..cosim_proto::trace::HEADER_BYTES].to_vec();
+    for &k in order {
+        out.extend_from_slice(&full[spans[k].clone()]);
+    }
+    out
+}
+
 fn trace_of(out: &Path) -> String {
     out.join("trace").display().to_string()
 }
@@ -340,6 +356,52 @@ fn a_damaged_trace_or_an_unusable_answer_is_not_a_match() {
     // The other node's part of the same file is whole.
     assert_eq!(matched(&replay(&[&dir_s, "--node", "sph"])), 315);
 
+    // Two of fem-node's commands swapped, or one removed: said before the node starts, naming the file's record
+    // (found 2026-12-06 by the sweep of damaged traces, D22: the node was blamed, "no answer from fem-node within
+    // 10 s", and the record numbered among the node's own).
+    let fem_command = |step| {
+        records
+            .iter()
+            .position(|r| {
+                r.kind == cosim_proto::trace::Kind::Command && r.node == cosim_proto::trace::Node::Fem && r.step == step
+            })
+            .unwrap()
+    };
+    let (c9, c10, c11) = (fem_command(9), fem_command(10), fem_command(11));
+    let mut order: Vec<usize> = (0..records.len()).collect();
+    order.swap(c10, c11);
+    let file = dir.join("trace.bin");
+    std::fs::write(&file, reordered(&full, &records, &order)).unwrap();
+    let got = replay(&[&dir_s, "--node", "fem"]);
+    let said = text(&got);
+    assert_eq!(got.status.code(), Some(2), "{said}");
+    assert_eq!(
+        said.trim(),
+        format!(
+            "cosim: {}: record {c10} (command of step 11): comes after the command of step 9 (record {c9}): the \
+             commands are out of order (a record lost, moved or changed)",
+            file.display()
+        )
+    );
+    let state10 = records
+        .iter()
+        .position(|r| {
+            r.kind == cosim_proto::trace::Kind::State && r.node == cosim_proto::trace::Node::Fem && r.step == 10
+        })
+        .unwrap();
+    let order: Vec<usize> = (0..records.len()).filter(|&k| k != c10).collect();
+    std::fs::write(&file, reordered(&full, &records, &order)).unwrap();
+    let got = replay(&[&dir_s, "--node", "fem"]);
+    let said = text(&got);
+    assert_eq!(got.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains(&format!(
+            "record {} (state of step 10): the last command before it is record {c9} (step 9), of another step: the \
+             trace is damaged",
+            state10 - 1
+        )),
+        "{said}"
+    );
     // A device is not a trace, and is not read (/dev/zero was read until 6.5 GB were taken).
     let zero = replay(&["/dev/zero", "--node", "fem"]);
     assert_eq!(zero.status.code(), Some(2), "{}", text(&zero));

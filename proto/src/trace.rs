@@ -102,6 +102,9 @@ pub struct Record {
     pub step: u64,
     /// The message as it went over the wire (an encoded envelope), or the text of a scene or end record.
     pub payload: Vec<u8>,
+    /// Its place in the file, 0 for the first record, counting those [`parse_with`] left out: what a message about
+    /// it names (a replay said "record 5" for the file's record 10, found 2026-12-06 by the sweep of damaged traces).
+    pub index: usize,
 }
 
 /// The file header for a run speaking protocol `protocol_version`.
@@ -190,6 +193,7 @@ pub fn parse_with(bytes: &[u8], mut keep: impl FnMut(Kind, Node) -> bool) -> Res
     let protocol_version = u32_at(head, 12);
     let mut records = Vec::new();
     let mut at = HEADER_BYTES;
+    let mut index = 0;
     let torn = loop {
         if at == bytes.len() {
             break None;
@@ -218,6 +222,7 @@ pub fn parse_with(bytes: &[u8], mut keep: impl FnMut(Kind, Node) -> bool) -> Res
         let mut step = [0u8; 8];
         step.copy_from_slice(&body[2..RECORD_FIXED_BYTES]);
         at = start + len;
+        index += 1;
         if !keep(kind, node) {
             continue;
         }
@@ -226,6 +231,7 @@ pub fn parse_with(bytes: &[u8], mut keep: impl FnMut(Kind, Node) -> bool) -> Res
             node,
             step: u64::from_le_bytes(step),
             payload: body[RECORD_FIXED_BYTES..].to_vec(),
+            index: index - 1,
         });
     };
     Ok(Trace {

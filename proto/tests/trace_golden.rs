@@ -110,6 +110,8 @@ fn golden_trace_reads_back() {
     // One node's part: the other records are read past, not kept.
     let fem = trace::parse_with(&hex(GOLDEN), |_, node| node == Node::Fem).unwrap();
     assert_eq!((fem.records.len(), fem.records[0].step, fem.torn), (1, 3, None));
+    // Its place in the whole file (after the scene), not among the records kept.
+    assert_eq!(fem.records[0].index, 1);
 }
 
 /// A file cut at any byte (a process killed mid-write) reads up to its last complete record and says where it stops.
@@ -157,6 +159,7 @@ fn a_damaged_record_is_where_reading_stops() {
         node: Node::Sph,
         step: 9,
         payload: vec![1, 2, 3],
+        index: 0,
     };
     let mut one = trace::header(2).to_vec();
     one.extend(trace::encode(r.kind, r.node, r.step, &r.payload).unwrap());

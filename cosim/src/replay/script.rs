@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use cosim_proto::envelope::Envelope;
-use cosim_proto::messages::StepCommand;
+use cosim_proto::messages::{FemMesh, FemState, NodeCheckpoint, NodeError, SphSetup, SphState, StepCommand};
 use cosim_proto::trace::{self, Kind, Node, RawEnvelope, Torn};
+use serde::de::DeserializeOwned;
 
 use crate::cli::ExternalNode;
 
@@ -30,6 +31,8 @@ pub struct Exchange {
     pub stop: bool,
     /// The recorded answer; `None` when the trace ends before it.
     pub answer: Option<Answer>,
+    /// The command's record in the file (0 = the first).
+    pub record: usize,
 }
 
 /// One node's part of a trace.
@@ -59,8 +62,16 @@ pub fn trace_file(path: &Path) -> PathBuf {
     }
 }
 
+/// A recorded message, decoded under its own run id: what a replay would fail on later, said before the node starts.
+fn decode<B: DeserializeOwned>(payload: &[u8], what: &'static str) -> Result<Envelope<B>, String> {
+    let raw = RawEnvelope::split(payload).ok_or("not an envelope")?;
+    Envelope::<B>::decode(payload, raw.run, what).map_err(|e| e.to_string())
+}
+
 /// The trace's records for `node`. Bad input (a file that is not a trace, a node the run did not have, a message
-/// that does not decode) is an error naming the file and the record.
+/// that does not decode, records out of order) is an error naming the file and the record (its index in the file),
+/// said before the node starts (found 2026-12-06 by the sweep of damaged traces, D22: two command records swapped
+/// were replayed, and the node blamed, "no answer from fem-node within 10 s").
 pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
     let path = trace_file(path);
     // A regular file, before it is read whole: /dev/zero was read until 6.5 GB were taken (2026-12-06).
@@ -87,7 +98,9 @@ pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
     let mut setup = None;
     let mut end = None;
     let mut exchanges: Vec<Exchange> = Vec::new();
-    for (i, r) in trace.records.into_iter().enumerate() {
+    for r in trace.records {
+        // The file's record index (not the index among this node's records), found 2026-12-06 by the sweep, D22.
+        let i = r.index;
         let bad = |why: &str| {
             anyhow::anyhow!(
                 "{}: record {i} ({} of step {}): {why}",
@@ -100,27 +113,80 @@ pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
             (Kind::Scene, _) => scene = Some(String::from_utf8(r.payload.clone()).map_err(|_| bad("not UTF-8"))?),
             (Kind::End, _) => end = Some(String::from_utf8_lossy(&r.payload).into_owned()),
             (_, n) if n != who => {}
-            (Kind::Restore, _) => restore = Some(r.payload),
-            (Kind::Setup, _) => setup = Some(r.payload),
+            (Kind::Restore, _) => {
+                decode::<NodeCheckpoint>(&r.payload, "restore").map_err(|e| bad(&e))?;
+                restore = Some(r.payload)
+            }
+            (Kind::Setup, _) => {
+                match node {
+                    ExternalNode::Fem => decode::<FemMesh>(&r.payload, "setup").map(|_| ()),
+                    ExternalNode::Sph => decode::<SphSetup>(&r.payload, "setup").map(|_| ()),
+                }
+                .map_err(|e| bad(&e))?;
+                setup = Some(r.payload)
+            }
             (Kind::Command, _) => {
-                let raw = RawEnvelope::split(&r.payload).ok_or_else(|| bad("not an envelope"))?;
-                let env =
-                    Envelope::<StepCommand>::decode(&r.payload, raw.run, "command").map_err(|e| bad(&e.to_string()))?;
+                let env = decode::<StepCommand>(&r.payload, "command").map_err(|e| bad(&e))?;
+                if env.step != r.step {
+                    return Err(bad(&format!("its envelope is for step {}", env.step)));
+                }
+                // The broker records each command once, the next step's after the last's answer.
+                if let Some(last) = exchanges.last().filter(|x| x.step + 1 != env.step) {
+                    return Err(bad(&format!(
+                        "comes after the command of step {} (record {}): the commands are out of order (a record lost, \
+                         moved or changed)",
+                        last.step, last.record
+                    )));
+                }
                 exchanges.push(Exchange {
                     step: env.step,
                     command: r.payload,
                     stop: env.body.stop,
                     answer: None,
+                    record: i,
                 });
             }
             (Kind::State | Kind::Error, _) => {
-                // The answer belongs to the last command sent for its step.
                 let answer = match r.kind {
-                    Kind::State => Answer::State(r.payload),
-                    _ => Answer::Error(r.payload),
+                    Kind::State => {
+                        let step = match node {
+                            ExternalNode::Fem => decode::<FemState>(&r.payload, "state").map(|e| e.step),
+                            ExternalNode::Sph => decode::<SphState>(&r.payload, "state").map(|e| e.step),
+                        }
+                        .map_err(|e| bad(&e))?;
+                        if step != r.step {
+                            return Err(bad(&format!("its envelope is for step {step}")));
+                        }
+                        Answer::State(r.payload)
+                    }
+                    // A node reports its failure with step 0 in its envelope: the record holds the step.
+                    _ => {
+                        decode::<NodeError>(&r.payload, "error").map_err(|e| bad(&e))?;
+                        Answer::Error(r.payload)
+                    }
                 };
-                if let Some(x) = exchanges.iter_mut().rev().find(|x| x.step == r.step && !x.stop) {
-                    x.answer.get_or_insert(answer);
+                // The answer to the last command, recorded once, before the next command: an answer anywhere else
+                // was replayed against the wrong command, and the node blamed for the silence that followed (D22).
+                let error = r.kind == Kind::Error;
+                match exchanges.last_mut() {
+                    Some(x) if x.step == r.step && !x.stop && x.answer.is_none() => x.answer = Some(answer),
+                    // A failure report after the answer or the stop, or before any command (at the restore): the
+                    // broker records it under the last command's step; there is nothing to replay it against.
+                    Some(x) if error && x.step == r.step => {}
+                    None if error => {}
+                    Some(x) => {
+                        let why = match (x.step == r.step, x.stop) {
+                            (_, true) => "a stop command, which has no answer",
+                            (true, false) => "already answered",
+                            (false, false) => "of another step",
+                        };
+                        return Err(bad(&format!(
+                            "the last command before it is record {} (step {}), {why}: the trace is damaged (a record \
+                             lost, moved or changed)",
+                            x.record, x.step
+                        )));
+                    }
+                    None => return Err(bad("no command comes before it: the trace is damaged")),
                 }
             }
         }
@@ -133,9 +199,10 @@ pub fn read(path: &Path, node: ExternalNode) -> anyhow::Result<Script> {
         let x = &exchanges[k];
         if let Some(later) = exchanges[k + 1..].iter().find(|y| y.step != x.step) {
             anyhow::bail!(
-                "{}: the command of step {} has no answer, yet step {} follows it: the trace is damaged (a record lost \
-                 or changed)",
+                "{}: record {}: the command of step {} has no answer, yet step {} follows it: the trace is damaged (a \
+                 record lost or changed)",
                 path.display(),
+                x.record,
                 x.step,
                 later.step
             );
