@@ -215,6 +215,19 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
         ],
     );
 
+    // broker.bin with a fluid step no run takes (1e-300 s, under coupling.max_dt / 2^32): it was accepted, and the
+    // run took one tiny extra step (found 2026-12-06 by the sweep of crafted checkpoints, D25).
+    let bad = copy_of(&ck, &dir.join("broker-dt"));
+    let (tag, format, mut state): SavedBroker =
+        bincode::deserialize(&std::fs::read(ck.join("broker.bin")).unwrap()).unwrap();
+    state.dt_fluid = 1e-300;
+    rewrite(&bad, "broker.bin", &bincode::serialize(&(tag, format, state)).unwrap());
+    assert_refused(
+        &bad,
+        &dir.join("out-broker-dt"),
+        &["broker.bin: dt_fluid = 1e-300 s is below coupling.max_dt / 2^32 = "],
+    );
+
     // sph.bin with one velocity more than there are particles: the fluid node refuses it when it starts, reports it
     // on its error topic, and the run fails with that reason (exit 1, summary.json `failed`).
     let bad = copy_of(&ck, &dir.join("sph-length"));

@@ -6,6 +6,7 @@
 
 use cosim_proto::messages::Correction;
 use cosim_proto::scene::Scene;
+use cosim_proto::Num;
 use serde::{Deserialize, Serialize};
 
 use crate::probes::LoadLog;
@@ -83,16 +84,24 @@ impl BrokerState {
         ensure(s.sim_time.to_bits() == self.t.to_bits(), || {
             format!("summary.sim_time = {} where t = {}", s.sim_time, self.t)
         })?;
-        // A step of 0 or less (or NaN, which `min` passes over) would never reach the end: the run would hang.
-        ensure(self.dt_fluid > 0.0, || {
-            format!("dt_fluid = {} is not a positive step", self.dt_fluid)
-        })?;
-        ensure(self.dt_contact > 0.0, || {
-            format!("dt_contact = {} is not a positive step", self.dt_contact)
-        })?;
-        ensure(self.dt_structure > 0.0, || {
-            format!("dt_structure = {} is not a positive step", self.dt_structure)
-        })?;
+        // A step of 0 or less (or NaN, which `min` passes over) would never reach the end: the run would hang. One
+        // below the shortest a run takes would end it `unstable` at once, or take a step no run takes (dt_fluid =
+        // 1e-300 was accepted, found 2026-12-06 by the sweep of crafted checkpoints, D25).
+        let shortest = crate::coordinator::shortest_step(scene.coupling.max_dt);
+        for (field, dt) in [
+            ("dt_fluid", self.dt_fluid),
+            ("dt_contact", self.dt_contact),
+            ("dt_structure", self.dt_structure),
+        ] {
+            ensure(dt > 0.0, || format!("{field} = {dt} is not a positive step"))?;
+            ensure(dt >= shortest, || {
+                format!(
+                    "{field} = {} s is below coupling.max_dt / 2^32 = {} s, the shortest step a run takes",
+                    Num(dt),
+                    Num(shortest)
+                )
+            })?;
+        }
         if let Some(g) = &s.energy_growth {
             // A budget that is not positive would divide every later gain by zero or turn its sign.
             ensure(
@@ -386,6 +395,19 @@ component = "x"
             let e = refused(|s| s.dt_structure = dt);
             assert_eq!(e, format!("dt_structure = {dt} is not a positive step"));
         }
+        // Positive, but below coupling.max_dt / 2^32 (the scene's default max_dt, 1e-4 s).
+        let floor = crate::coordinator::shortest_step(scene().coupling.max_dt);
+        assert_eq!(
+            refused(|s| s.dt_fluid = 1e-300),
+            format!(
+                "dt_fluid = 1e-300 s is below coupling.max_dt / 2^32 = {} s, the shortest step a run takes",
+                Num(floor)
+            )
+        );
+        assert!(refused(|s| s.dt_structure = floor * 0.5).starts_with("dt_structure = "));
+        let mut at_floor = state();
+        at_floor.dt_contact = floor;
+        assert_eq!(at_floor.check(&scene()), Ok(()));
         let e = refused(|s| s.next_output = 2);
         assert!(
             e.starts_with("next_output = 2: output time 0.2 s is not after t = 0.25 s"),

@@ -10,6 +10,12 @@ use crate::summary::Summary;
 /// Steps closer than this fraction of `max_dt` to an output time land on it.
 pub(super) const LANDING: f64 = 1e-9;
 
+/// The shortest coupling step a run takes, `coupling.max_dt` / 2^32 [s]: a shorter one cannot move the run on
+/// ([`Clock::check_step`]), and a restored bound below it is refused (`checkpoint::BrokerState::check`).
+pub fn shortest_step(max_dt: f64) -> f64 {
+    max_dt / 4_294_967_296.0
+}
+
 /// Where the run is in time, and the fluid's stable step that bounds the next coupling step.
 pub(super) struct Clock {
     /// Simulated time [s].
@@ -194,7 +200,7 @@ impl Clock {
     /// steps for ever at a frozen time; it ends `unstable`, naming the node and the value that set the step (the
     /// fluid node ends its own run the same way where one coupling step would take it 2^32 of its steps).
     pub fn check_step(&self, step: &Step) -> Result<(), crate::link::LinkError> {
-        let floor = self.max_dt / 4_294_967_296.0;
+        let floor = shortest_step(self.max_dt);
         if step.lands || (step.dt >= floor && self.t + step.dt > self.t) {
             return Ok(());
         }
