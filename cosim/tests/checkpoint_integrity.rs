@@ -229,7 +229,8 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
     );
 
     // sph.bin with one velocity more than there are particles: the fluid node refuses it when it starts, reports it
-    // on its error topic, and the run fails with that reason (exit 1, summary.json `failed`).
+    // on its error topic, and the run fails with that reason (exit 1, summary.json `failed`), naming the file (it
+    // said "checkpoint: …", found 2026-12-06 by the sweep of crafted checkpoints, D23).
     let bad = copy_of(&ck, &dir.join("sph-length"));
     type SavedFluid = (String, u32, SphCheckpoint);
     let (tag, version, mut fluid): SavedFluid =
@@ -238,7 +239,7 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
     fluid.solver.state.v.push([0.0; 2]);
     rewrite(&bad, "sph.bin", &bincode::serialize(&(tag, version, &fluid)).unwrap());
     let why = format!(
-        "checkpoint: state.v holds {} entries, there are {n} fluid particles",
+        "cannot restart from the checkpoint: sph.bin: state.v holds {} entries, there are {n} fluid particles",
         n + 1
     );
     let out = dir.join("out-sph-length");
@@ -254,6 +255,21 @@ fn a_state_whose_checksum_matches_but_does_not_hold_together_is_refused_naming_t
     let stderr = String::from_utf8_lossy(&got.stderr);
     assert_eq!(got.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("sph-node") && stderr.contains(&why), "{stderr}");
+
+    // fem.bin cut short (its checksum rewritten): the structure node names the file too.
+    let bad = copy_of(&ck, &dir.join("fem-cut"));
+    let fem = std::fs::read(ck.join("fem.bin")).unwrap();
+    rewrite(&bad, "fem.bin", &fem[..fem.len() - 9]);
+    let out = dir.join("out-fem-cut");
+    let got = restart(&bad, &out, false);
+    let stderr = String::from_utf8_lossy(&got.stderr);
+    assert_eq!(got.status.code(), Some(1), "the run fails: {stderr}");
+    let message = json(&out.join("summary.json"))["message"].as_str().unwrap().to_string();
+    assert!(
+        message.contains("fem-node")
+            && message.contains("cannot restart from the checkpoint: fem.bin: not a structure node's state: "),
+        "{message}"
+    );
 }
 
 /// A `broker.bin` and manifest whose time was moved (0.01 → 0.0149 s), the checksum rewritten: the nodes' states are

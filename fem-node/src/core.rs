@@ -76,8 +76,10 @@ impl FemCore {
     /// where they are clamped; a state that does not hold together is refused naming the field, and the core keeps
     /// the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), FemError> {
+        // Named as the checkpoint's file: "checkpoint: not a structure node's state: io error: …" named none (found
+        // 2026-12-06 by the sweep of crafted checkpoints, D23).
         let invalid = |message: String| FemError::InvalidParameter {
-            name: "checkpoint",
+            name: cosim_proto::keys::FEM.checkpoint_file,
             message,
         };
         let (tag, version, state, stale): (String, u32, SolverState, bool) = bincode::DefaultOptions::new()

@@ -90,15 +90,15 @@ fn lengths_that_disagree_are_refused_naming_the_field() {
         refused(&edited(|s| {
             s.v.pop();
         })),
-        "checkpoint: state.v holds 5 nodes, the model has 6"
+        "fem.bin: state.v holds 5 nodes, the model has 6"
     );
     assert_eq!(
         refused(&edited(|s| s.a.push([0.0; 2]))),
-        "checkpoint: state.a holds 7 nodes, the model has 6"
+        "fem.bin: state.a holds 7 nodes, the model has 6"
     );
     assert_eq!(
         refused(&edited(|s| s.x.clear())),
-        "checkpoint: state.x holds 0 nodes, the model has 6"
+        "fem.bin: state.x holds 0 nodes, the model has 6"
     );
 }
 
@@ -106,22 +106,22 @@ fn lengths_that_disagree_are_refused_naming_the_field() {
 fn values_that_are_not_finite_or_not_where_clamped_are_refused() {
     assert_eq!(
         refused(&edited(|s| s.x[4] = [f64::NAN, 0.1])),
-        "checkpoint: state.x[4] = [NaN, 0.1] is not finite within ±1e50"
+        "fem.bin: state.x[4] = [NaN, 0.1] is not finite within ±1e50"
     );
     // Finite but beyond any state (2026-12-06): the run failed at its first step as a collapsed element.
     assert_eq!(
         refused(&edited(|s| s.x[4] = [1e300, 0.1])),
-        "checkpoint: state.x[4] = [1e300, 0.1] is not finite within ±1e50"
+        "fem.bin: state.x[4] = [1e300, 0.1] is not finite within ±1e50"
     );
     assert_eq!(
         refused(&edited(|s| s.t = f64::INFINITY)),
-        "checkpoint: state.t = inf is not a time"
+        "fem.bin: state.t = inf is not a time"
     );
     // Node 3 is (0, 0.1), on the clamped edge.
     let e = refused(&edited(|s| s.v[3] = [0.0, -1.0]));
     assert_eq!(
         e,
-        "checkpoint: state: node 3 is clamped at [0.0, 0.1] but has x [0.0, 0.1], v [0.0, -1.0], a [0.0, 0.0]"
+        "fem.bin: state: node 3 is clamped at [0.0, 0.1] but has x [0.0, 0.1], v [0.0, -1.0], a [0.0, 0.0]"
     );
 }
 
@@ -130,7 +130,7 @@ fn bytes_that_are_not_a_state_are_refused() {
     let (_, mut data) = saved();
     data.push(0);
     let e = refused(&data);
-    assert!(e.starts_with("checkpoint: not a structure node's state:"), "{e}");
+    assert!(e.starts_with("fem.bin: not a structure node's state:"), "{e}");
     let e = refused(&data[..data.len() - 9]);
-    assert!(e.starts_with("checkpoint: not a structure node's state:"), "{e}");
+    assert!(e.starts_with("fem.bin: not a structure node's state:"), "{e}");
 }

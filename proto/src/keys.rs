@@ -88,6 +88,9 @@ pub struct NodeTopics {
     pub checkpoint: &'static str,
     /// Restart state queryable (served by the broker).
     pub restore: &'static str,
+    /// The file of a checkpoint folder that holds the node's state (`docs/PROTOCOL.md` §9): what the node names
+    /// when it refuses the state it is given to continue from.
+    pub checkpoint_file: &'static str,
 }
 
 /// The structure node's topics.
@@ -101,6 +104,7 @@ pub const FEM: NodeTopics = NodeTopics {
     status: topic::FEM_STATUS,
     checkpoint: topic::FEM_CHECKPOINT,
     restore: topic::FEM_RESTORE,
+    checkpoint_file: "fem.bin",
 };
 
 /// The fluid node's topics.
@@ -114,4 +118,5 @@ pub const SPH: NodeTopics = NodeTopics {
     status: topic::SPH_STATUS,
     checkpoint: topic::SPH_CHECKPOINT,
     restore: topic::SPH_RESTORE,
+    checkpoint_file: "sph.bin",
 };

@@ -152,8 +152,10 @@ impl SphCore {
     /// ([`FluidSolver::restore`], `restore.rs`); a state that does not hold together is refused naming the
     /// field, and the core keeps the scene's state.
     pub fn restore(&mut self, data: &[u8]) -> Result<(), SphError> {
+        // Named as the checkpoint's file: "checkpoint: not a fluid node's state: io error: …" named none (found
+        // 2026-12-06 by the sweep of crafted checkpoints, D23).
         let invalid = |message: String| SphError::InvalidParameter {
-            name: "checkpoint",
+            name: cosim_proto::keys::SPH.checkpoint_file,
             message,
         };
         let not_ours = |e: bincode::Error| invalid(format!("not a fluid node's state: {e}"));

@@ -98,7 +98,7 @@ fn a_checkpoint_of_another_version_is_refused_naming_both() {
         assert_eq!(
             refused(solver, &old),
             format!(
-                "checkpoint: holds `cosim-sph-checkpoint` version 6, this sph-node reads `cosim-sph-checkpoint` \
+                "sph.bin: holds `cosim-sph-checkpoint` version 6, this sph-node reads `cosim-sph-checkpoint` \
                  version {} (restart the run from its start)",
                 CHECKPOINT_TAG.1
             ),
@@ -115,7 +115,7 @@ fn a_state_with_lengths_that_disagree_is_refused_naming_the_field() {
         assert_eq!(
             e,
             format!(
-                "checkpoint: state.v holds {} entries, there are {n} fluid particles",
+                "sph.bin: state.v holds {} entries, there are {n} fluid particles",
                 n + 1
             ),
             "{solver}"
@@ -129,40 +129,40 @@ fn a_state_with_lengths_that_disagree_is_refused_naming_the_field() {
         assert_eq!(
             e,
             format!(
-                "checkpoint: state.rho holds {} entries, there are {n} fluid particles",
+                "sph.bin: state.rho holds {} entries, there are {n} fluid particles",
                 n - 1
             ),
             "{solver}"
         );
         let e = refused(solver, &edited(solver, |s| s.solver.state.p[9] = f64::NAN));
-        assert_eq!(e, "checkpoint: state.p[9] = NaN is not finite within ±1e50", "{solver}");
+        assert_eq!(e, "sph.bin: state.p[9] = NaN is not finite within ±1e50", "{solver}");
         let e = refused(solver, &edited(solver, |s| s.solver.state.x[2] = [1e6, 0.0]));
         assert_eq!(
-            e, "checkpoint: state.x[2] = [1000000.0, 0.0] is outside the fluid's domain",
+            e, "sph.bin: state.x[2] = [1000000.0, 0.0] is outside the fluid's domain",
             "{solver}"
         );
         let e = refused(solver, &edited(solver, |s| s.solver.walls.p.push(0.0)));
-        assert!(e.starts_with("checkpoint: walls.p holds"), "{solver}: {e}");
+        assert!(e.starts_with("sph.bin: walls.p holds"), "{solver}: {e}");
         let e = refused(solver, &edited(solver, |s| s.solver.state.m[2] *= 2.0));
-        assert!(e.starts_with("checkpoint: state.m[2] = "), "{solver}: {e}");
+        assert!(e.starts_with("sph.bin: state.m[2] = "), "{solver}: {e}");
         let e = refused(solver, &edited(solver, |s| s.solver.own.truncate(3)));
-        assert!(e.starts_with(&format!("checkpoint: {solver} state: ")), "{solver}: {e}");
+        assert!(e.starts_with(&format!("sph.bin: {solver} state: ")), "{solver}: {e}");
     }
 }
 
 #[test]
 fn a_guard_or_solver_other_than_the_scenes_is_refused() {
     let e = refused("wcsph", &edited("wcsph", |s| s.guard.bound *= 2.0));
-    assert!(e.starts_with("checkpoint: guard.bound = "), "{e}");
+    assert!(e.starts_with("sph.bin: guard.bound = "), "{e}");
     let e = refused("isph", &saved("wcsph"));
     assert_eq!(
         e,
-        "checkpoint: saved with fluid.solver = \"wcsph\", the scene has \"isph\""
+        "sph.bin: saved with fluid.solver = \"wcsph\", the scene has \"isph\""
     );
     let mut data = saved("wcsph");
     data.push(0);
     let e = refused("wcsph", &data);
-    assert!(e.starts_with("checkpoint: not a fluid node's state:"), "{e}");
+    assert!(e.starts_with("sph.bin: not a fluid node's state:"), "{e}");
 }
 
 /// Steps `solver` `n` times at its stable step, after a contact-like correction of particle 0 before the

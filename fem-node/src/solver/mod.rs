@@ -96,7 +96,7 @@ impl FemSolver {
     /// hold together is refused and the solver keeps its own.
     pub fn resume(&mut self, state: FemState, accelerations_stale: bool) -> Result<()> {
         state.check(&self.model).map_err(|message| FemError::InvalidParameter {
-            name: "checkpoint",
+            name: cosim_proto::keys::FEM.checkpoint_file,
             message,
         })?;
         self.state = state;
