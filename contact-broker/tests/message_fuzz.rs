@@ -64,6 +64,10 @@ enum MeshSpoil {
     NoInterface,
     HugeCellSolid(usize),
     Scale(f64),
+    ReversedCell(usize),
+    SegmentTwice(usize),
+    FixedTwice(usize),
+    SecondSolid,
 }
 
 #[derive(Clone, Debug)]
@@ -148,6 +152,10 @@ fn spoils() -> impl Strategy<Value = Spoil> {
         Just(MeshSpoil::NoInterface),
         (1usize..200_000).prop_map(MeshSpoil::HugeCellSolid),
         prop_oneof![Just(20.0), Just(1e6)].prop_map(MeshSpoil::Scale),
+        any::<usize>().prop_map(MeshSpoil::ReversedCell),
+        any::<usize>().prop_map(MeshSpoil::SegmentTwice),
+        any::<usize>().prop_map(MeshSpoil::FixedTwice),
+        Just(MeshSpoil::SecondSolid),
     ];
     let fem = prop_oneof![
         (any::<usize>(), any::<u32>()).prop_map(|(i, v)| FemSpoil::Id(i, v)),
@@ -263,6 +271,32 @@ fn spoil_mesh(m: &mut FemMesh, how: &MeshSpoil) -> &'static str {
         MeshSpoil::Scale(f) => {
             m.nodes.iter_mut().for_each(|x| *x = x.map(|c| c * f));
             "interface"
+        }
+        MeshSpoil::ReversedCell(i) => {
+            let k = pick(i, m.cells.len());
+            m.cells[k].reverse();
+            "cells"
+        }
+        MeshSpoil::SegmentTwice(i) => {
+            let k = pick(i, m.interface.len());
+            m.interface.push(m.interface[k]);
+            "interface"
+        }
+        MeshSpoil::FixedTwice(i) => {
+            if m.fixed.is_empty() {
+                m.fixed.push(0);
+            }
+            let k = pick(i, m.fixed.len());
+            m.fixed.push(m.fixed[k]);
+            "fixed"
+        }
+        MeshSpoil::SecondSolid => {
+            // A solid the scene does not have, owning the last cell.
+            m.solid_names.push("intruder".into());
+            if let Some(s) = m.cell_solid.last_mut() {
+                *s = 1;
+            }
+            "solid_names"
         }
     }
 }
@@ -513,6 +547,20 @@ fn the_sweeps_cases_are_refused_naming_their_field() {
             "sph/setup density = 1000000: the scene gives 1000",
         ),
         (Spoil::Mesh(MeshSpoil::NoInterface), "fem/mesh interface = 0 entries"),
+        // The mesh's geometry and the scene's solids (D15): a cell inside out, a segment and a clamped node listed
+        // twice, a solid the scene does not have.
+        (
+            Spoil::Mesh(MeshSpoil::ReversedCell(0)),
+            "fem/mesh cells[0] = [21, 22, 1, 0]: its nodes go clockwise or enclose nothing",
+        ),
+        (
+            Spoil::Mesh(MeshSpoil::SegmentTwice(3)),
+            "fem/mesh interface[44] = 3→4: the segment of interface[3] again",
+        ),
+        (
+            Spoil::Mesh(MeshSpoil::SecondSolid),
+            "fem/mesh solid_names = [\"plate\", \"intruder\"]: the scene's solids are [\"plate\"]",
+        ),
         // A plate registered a million times its size (`particle_particle` took 7.7 GB laying points along it).
         (
             Spoil::Mesh(MeshSpoil::Scale(1e6)),

@@ -30,6 +30,7 @@ pub(super) struct Round {
 pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::Result<()> {
     if let Some(link) = &nodes.fem {
         link.setup().validate().map_err(|e| unusable("fem-node", e))?;
+        check_solids(scene, link.setup())?;
         if nodes.sph.is_some() && link.setup().interface.is_empty() {
             return Err(unusable_because(
                 "fem-node",
@@ -125,6 +126,24 @@ fn check_surface(scene: &Scene, mesh: &cosim_proto::messages::FemMesh) -> anyhow
         ));
     }
     Ok(())
+}
+
+/// A structure node's solids are the scene's, by name and in scene order (PROTOCOL §5, `solid_names`): the probes
+/// find a solid by its name, and the surface's size is checked against the scene's solids. An outside node that
+/// registered a second solid the scene does not have ran `ok` (the sweep of hostile external nodes, D15). A scene
+/// without solids leaves the node's to it.
+fn check_solids(scene: &Scene, mesh: &cosim_proto::messages::FemMesh) -> anyhow::Result<()> {
+    let want: Vec<&str> = scene.solids.iter().map(|s| s.name.as_str()).collect();
+    if want.is_empty() || mesh.solid_names.iter().map(String::as_str).eq(want.iter().copied()) {
+        return Ok(());
+    }
+    Err(unusable_because(
+        "fem-node",
+        format!(
+            "fem/mesh solid_names = {:?}: the scene's solids are {want:?} (the same names in the same order)",
+            mesh.solid_names
+        ),
+    ))
 }
 
 /// A step command with nothing to correct and no region of interest.

@@ -199,108 +199,6 @@ impl Check {
     }
 }
 
-impl FemMesh {
-    /// Check the mesh a structure node registered (topic `fem/mesh`).
-    pub fn validate(&self) -> Result {
-        let c = Check("fem/mesh");
-        let (nodes, solids) = (self.nodes.len(), self.solid_names.len());
-        if nodes == 0 {
-            return Err(c.fail("nodes", &[], "0 entries", "a structure node needs nodes"));
-        }
-        if solids == 0 {
-            return Err(c.fail("solid_names", &[], "0 entries", "a structure node needs a solid"));
-        }
-        c.points("nodes", &self.nodes)?;
-        c.len("masses", self.masses.len(), nodes, "node")?;
-        for (i, m) in self.masses.iter().enumerate() {
-            c.positive("masses", &[i], *m)?;
-        }
-        c.len("node_solid", self.node_solid.len(), nodes, "node")?;
-        for (i, s) in self.node_solid.iter().enumerate() {
-            c.id("node_solid", &[i], *s, solids, "solids")?;
-        }
-        c.len("cell_solid", self.cell_solid.len(), self.cells.len(), "cell")?;
-        for (e, cell) in self.cells.iter().enumerate() {
-            if !(3..=4).contains(&cell.len()) {
-                return Err(c.fail(
-                    "cells",
-                    &[e],
-                    format!("{} node ids", cell.len()),
-                    "a cell has 3 or 4 nodes",
-                ));
-            }
-            for (k, id) in cell.iter().enumerate() {
-                c.id("cells", &[e, k], *id, nodes, "nodes")?;
-            }
-        }
-        for (e, s) in self.cell_solid.iter().enumerate() {
-            c.id("cell_solid", &[e], *s, solids, "solids")?;
-        }
-        for (i, Segment { a, b }) in self.interface.iter().enumerate() {
-            c.id("interface", &[i, 0], *a, nodes, "nodes")?;
-            c.id("interface", &[i, 1], *b, nodes, "nodes")?;
-            if a == b {
-                return Err(c.fail(
-                    "interface",
-                    &[i],
-                    format!("{a}→{b}"),
-                    "a segment joins two different nodes",
-                ));
-            }
-        }
-        self.check_boundary(c)?;
-        for (i, id) in self.fixed.iter().enumerate() {
-            c.id("fixed", &[i], *id, nodes, "nodes")?;
-        }
-        c.positive("dt_stable", &[], self.dt_stable)
-    }
-
-    /// The contact's geometry (ids already checked): every segment has a length, and each solid's segments go
-    /// counter-clockwise round it (its signed area Σ (x_a × x_b)/2 over them is > 0), so that their normals point out
-    /// of it. A clockwise boundary from an outside node ran `ok` with the contact pushing the water into the solid and
-    /// 0.66 of the water's energy made; segments of zero length, the same (found 2026-12-06 by a sweep of hostile
-    /// external nodes).
-    fn check_boundary(&self, c: Check) -> Result {
-        // Per solid: the signed area its segments enclose, and whether any segment starts on it.
-        let mut area = vec![(0.0, false); self.solid_names.len()];
-        for (i, Segment { a, b }) in self.interface.iter().enumerate() {
-            let (Some(pa), Some(pb)) = (self.nodes.get(*a as usize), self.nodes.get(*b as usize)) else {
-                continue;
-            };
-            if pa == pb {
-                return Err(c.fail(
-                    "interface",
-                    &[i],
-                    format!("{a}→{b}"),
-                    format!("a segment of zero length (both nodes at {pa:?})"),
-                ));
-            }
-            let solid = self.node_solid.get(*a as usize);
-            let Some(slot) = solid.and_then(|&s| area.get_mut(s as usize)) else {
-                continue;
-            };
-            slot.1 = true;
-            if self.node_solid.get(*b as usize) == solid {
-                slot.0 += 0.5 * (pa[0] * pb[1] - pa[1] * pb[0]);
-            }
-        }
-        for ((s, &(a, has)), name) in area.iter().enumerate().zip(&self.solid_names) {
-            if has && (a.is_nan() || a <= 0.0) {
-                return Err(c.fail(
-                    "interface",
-                    &[],
-                    format!("the segments of solid {s} ({name})"),
-                    format!(
-                        "they go clockwise round it or enclose nothing (signed area {a:e} m²): they must go \
-                         counter-clockwise, so that their normals point out of the solid"
-                    ),
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
 /// What the broker asked a node for in a step, which its answer must match.
 #[derive(Clone, Copy, Debug)]
 pub struct Asked<'a> {
@@ -554,5 +452,6 @@ fn validate_corrections(c: Check, corrections: &[Correction], count: usize, face
     Ok(())
 }
 
+mod mesh;
 #[cfg(test)]
 mod tests;

@@ -75,6 +75,34 @@ fn a_consistent_mesh_passes_and_each_inconsistency_is_named() {
             "fem/mesh interface = the segments of solid 0 (plate): they go clockwise round it or enclose nothing \
              (signed area -1e0 m²): they must go counter-clockwise, so that their normals point out of the solid",
         ),
+        // Found by the same sweep (D15): cells of one node, cells turned inside out, a segment or a clamped node
+        // listed twice.
+        (
+            |m| m.cells[0] = vec![0, 0, 0, 0],
+            "fem/mesh cells[0] = [0, 0, 0, 0]: node 0 is in it twice: a cell joins different nodes",
+        ),
+        (
+            |m| m.cells[0].reverse(),
+            "fem/mesh cells[0] = [3, 2, 1, 0]: its nodes go clockwise or enclose nothing (signed area -1e0 m²): a \
+             cell's nodes go counter-clockwise",
+        ),
+        (
+            |m| m.nodes[2] = [0.0, 0.0],
+            "fem/mesh cells[0] = [0, 1, 2, 3]: its nodes go clockwise or enclose nothing (signed area 0e0 m²): a \
+             cell's nodes go counter-clockwise",
+        ),
+        (
+            |m| m.interface.push(Segment { a: 1, b: 2 }),
+            "fem/mesh interface[4] = 1→2: the segment of interface[1] again: each boundary segment is listed once",
+        ),
+        (
+            |m| m.interface.push(Segment { a: 2, b: 1 }),
+            "fem/mesh interface[4] = 2→1: the segment of interface[1] again: each boundary segment is listed once",
+        ),
+        (
+            |m| m.fixed.push(0),
+            "fem/mesh fixed[2] = 0: node 0 is listed twice (also fixed[0])",
+        ),
     ];
     for (spoil, want) in cases {
         let mut m = mesh();
