@@ -17,10 +17,10 @@ struct Args {
     #[arg(long)]
     run: String,
     /// Endpoint of the broker or a router, e.g. tcp/127.0.0.1:7447.
-    #[arg(long, required = true)]
+    #[arg(long, required = true, value_parser = crate::session::endpoint)]
     connect: Vec<String>,
     /// Endpoints to listen on.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::session::endpoint)]
     listen: Vec<String>,
     /// Seconds to wait for the connection and the scene.
     #[arg(long, value_parser = crate::seconds::positive, default_value_t = 5.0)]

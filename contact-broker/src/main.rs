@@ -43,10 +43,10 @@ struct Args {
     #[arg(long = "set")]
     set: Vec<String>,
     /// Endpoints to listen on.
-    #[arg(long, default_value = "tcp/127.0.0.1:0")]
+    #[arg(long, default_value = "tcp/127.0.0.1:0", value_parser = cosim_bus::session::endpoint)]
     listen: Vec<String>,
     /// Endpoints (a router or peers) to connect to.
-    #[arg(long)]
+    #[arg(long, value_parser = cosim_bus::session::endpoint)]
     connect: Vec<String>,
     /// `--connect` is a zenoh router (`zenohd`): join through it as a client and listen on nothing; the nodes
     /// then join through the same router with `--client`.

@@ -103,7 +103,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub run_id: Option<String>,
     /// Connect every node to this zenoh router (e.g. `zenohd`) as a zenoh client instead of peer-to-peer on loopback.
-    #[arg(long)]
+    #[arg(long, value_parser = cosim_bus::session::endpoint)]
     pub connect: Option<String>,
     /// Worker threads per node (default: all cores; 1 to 1024).
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1024))]
@@ -261,7 +261,7 @@ pub struct InspectArgs {
     pub once: bool,
     /// Endpoint of the run (its broker's, or the router's) for a run on another host; a run on this machine is
     /// found without it.
-    #[arg(long)]
+    #[arg(long, value_parser = cosim_bus::session::endpoint)]
     pub connect: Option<String>,
     /// `--connect` is a zenoh router: join through it as a client.
     #[arg(long)]
@@ -289,7 +289,7 @@ pub struct InspectArgs {
 #[derive(Args, Debug, Clone)]
 pub struct RouterArgs {
     /// Endpoints to listen on (repeatable), e.g. `tcp/0.0.0.0:7447`, `tls/0.0.0.0:7447`.
-    #[arg(long, required = true)]
+    #[arg(long, required = true, value_parser = cosim_bus::session::endpoint)]
     pub listen: Vec<String>,
     /// A zenoh JSON5 config file the router starts from (a user/password dictionary, TLS certificates, …); mode,
     /// listen endpoints and multicast scouting off are put on top of it.

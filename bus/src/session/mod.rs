@@ -10,7 +10,10 @@ use std::path::Path;
 use anyhow::Context;
 use zenoh::{Session, Wait};
 
+mod endpoint;
 mod settings;
+
+pub use endpoint::{endpoint, TRANSPORTS};
 
 /// The base config: zenoh's defaults without a file, else the file (JSON5, `.json5` or `.json`; YAML `.yaml`)
 /// read with `zenoh::Config::from_file`. A file that cannot be read or parsed is one error naming it.
