@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use cosim_proto::control::{ControlCommand, ControlReply};
+use cosim_proto::control::{ControlCommand, ControlReply, StateOf};
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic};
 use zenoh::handlers::FifoChannelHandler;
@@ -50,11 +50,14 @@ impl RemoteControl {
 
     /// Answer a state query from `halt`: an envelope of `DebugState`, or an error naming what failed.
     fn answer_state(&self, query: Query, halt: &mut Halt<'_, '_>) {
-        let encoded = halt.state().map_err(|e| e.to_string()).and_then(|s| {
-            Envelope::new(&self.run, halt.step, halt.t, s)
-                .encode_checked(topic::BROKER_STATE)
-                .map_err(|e| e.to_string())
-        });
+        let of = StateOf::parse(query.parameters().get(StateOf::PARAMETER));
+        let encoded = of
+            .and_then(|of| halt.state(of).map_err(|e| e.to_string()))
+            .and_then(|s| {
+                Envelope::new(&self.run, halt.step, halt.t, s)
+                    .encode_checked(topic::BROKER_STATE)
+                    .map_err(|e| e.to_string())
+            });
         let sent = match encoded {
             Ok(bytes) => query.reply(query.key_expr().clone(), bytes).wait(),
             Err(why) => query.reply_err(why).wait(),

@@ -359,6 +359,7 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
 
     fn checkpoint(&mut self, step: u64) -> Result<Vec<u8>, LinkError> {
         let what = self.topics.checkpoint;
+        let asked = std::time::Instant::now();
         // Asked again while nobody answers, for as long as a link lost and restored takes to come back (it takes the
         // node's queryable away for a moment); a node that died is not waited for longer.
         let answers = cosim_bus::ask::ask_within(
@@ -368,10 +369,13 @@ impl<S: DeserializeOwned, T: DeserializeOwned + Reply> NodeLink for ZenohLink<S,
             link_loss::GRACE,
         )
         .map_err(|e| self.failed(format!("cannot ask for a checkpoint: {e}")))?;
+        // Nobody there is known within the grace, not the step's timeout (a node that says "did not answer within
+        // 60 s" after 4 s misled, found 2026-12-07).
         let reply = answers.into_iter().next().ok_or_else(|| {
             self.failed(format!(
-                "did not answer {what} within {:.0} s (an outside program in a node's place may not save checkpoints)",
-                self.step_timeout.as_secs_f64()
+                "did not answer {what} (asked for {:.0} s; an outside program in a node's place may not save \
+                 checkpoints)",
+                asked.elapsed().as_secs_f64()
             ))
         })?;
         let sample = reply.result().map_err(|e| {

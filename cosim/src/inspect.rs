@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use cosim_bus::status::query_all;
+use cosim_proto::control::StateOf;
 
 use crate::cli::InspectArgs;
 
@@ -116,18 +117,30 @@ fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
     // A state is a checkpoint of every node: it may take longer than a status.
     let how = join_args(args, args.timeout.max(10.0));
     let (session, connect) = crate::join::join(&args.id, &how)?;
-    let look = match crate::look::fetch(&session, &args.id, cosim_bus::seconds::wait(how.timeout)) {
-        Ok(look) => look,
-        Err(e) => {
-            eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
-            return Ok(ExitCode::from(1));
-        }
+    let wait = cosim_bus::seconds::wait(how.timeout);
+    let fetch = |of| crate::look::fetch(&session, &args.id, wait, of);
+    // A particle needs the fluid's state; the structure's only for its contact. Where the run's state cannot be had
+    // whole (an outside program in the structure node's place saves no checkpoint), the fluid's alone is asked for.
+    let (look, partial) = match fetch(StateOf::All) {
+        Ok(look) => (look, None),
+        Err(e) => match args.particle.is_some().then(|| fetch(StateOf::Fluid)) {
+            Some(Ok(look)) => (look, Some(e)),
+            _ => {
+                eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
+                return Ok(ExitCode::from(1));
+            }
+        },
     };
-    let doc = match (args.particle, args.node) {
+    let mut doc = match (args.particle, args.node) {
         (Some(p), _) => crate::look::particle(&look, p)?,
         (None, Some(n)) => crate::look::node(&look, n)?,
         (None, None) => unreachable!("inspect_one is called with --particle or --node"),
     };
+    if let Some(e) = partial {
+        let why = format!("{e:#}");
+        eprintln!("cosim: the structure is not shown (its contact with the particle neither): {why}");
+        doc["structure"] = serde_json::Value::String(format!("not shown: {why}"));
+    }
     println!("{doc:#}");
     Ok(ExitCode::SUCCESS)
 }

@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use anyhow::Context;
-use cosim_proto::control::{ContactRecord, DebugState};
+use cosim_proto::control::{ContactRecord, DebugState, StateOf};
 use cosim_proto::envelope::Envelope;
 use cosim_proto::keys::{key, topic};
 use cosim_proto::messages::{Correction, FemMesh, FemSnapshot, StepCommand};
@@ -42,9 +42,14 @@ pub struct Look {
     pub debug: DebugState,
 }
 
-fn ask(session: &Session, id: &str, what: &str, timeout: Duration) -> anyhow::Result<Vec<u8>> {
+/// Ask run `id`'s broker for `what`, with the selector's `parameters` (`""`: none).
+fn ask(session: &Session, id: &str, what: &str, parameters: &str, timeout: Duration) -> anyhow::Result<Vec<u8>> {
+    let selector = match parameters {
+        "" => key(id, what),
+        p => format!("{}?{p}", key(id, what)),
+    };
     let replies = session
-        .get(key(id, what))
+        .get(selector)
         .timeout(timeout)
         .wait()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -66,11 +71,12 @@ fn ask(session: &Session, id: &str, what: &str, timeout: Duration) -> anyhow::Re
     }
 }
 
-/// Fetch and read run `id`'s state now (a running run answers between two steps).
-pub fn fetch(session: &Session, id: &str, timeout: Duration) -> anyhow::Result<Look> {
-    let text = String::from_utf8(ask(session, id, topic::SCENE, timeout)?).context("the run's scene")?;
+/// Fetch and read run `id`'s state now (a running run answers between two steps): every node's, or the fluid's alone
+/// (`of`; the look then has no structure).
+pub fn fetch(session: &Session, id: &str, timeout: Duration, of: StateOf) -> anyhow::Result<Look> {
+    let text = String::from_utf8(ask(session, id, topic::SCENE, "", timeout)?).context("the run's scene")?;
     let scene = cosim_proto::scene::parse("(scene from the broker)", &text, &[])?;
-    let bytes = ask(session, id, topic::BROKER_STATE, timeout)?;
+    let bytes = ask(session, id, topic::BROKER_STATE, of.parameters(), timeout)?;
     let env = Envelope::<DebugState>::decode(&bytes, id, topic::BROKER_STATE)?;
     let fem = match env.body.fem.is_empty() {
         true => None,

@@ -28,7 +28,12 @@ pub fn snapshot(args: &SnapshotArgs) -> anyhow::Result<ExitCode> {
         args.out.display()
     );
     let (session, connect) = join(&args.id, &args.join)?;
-    let look = match look::fetch(&session, &args.id, cosim_bus::seconds::wait(args.join.timeout)) {
+    let look = match look::fetch(
+        &session,
+        &args.id,
+        cosim_bus::seconds::wait(args.join.timeout),
+        cosim_proto::control::StateOf::All,
+    ) {
         Ok(look) => look,
         Err(e) => {
             eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);

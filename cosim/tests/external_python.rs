@@ -256,6 +256,7 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
     let started = Instant::now();
     let until = started + LIMIT;
     let cosim_log = std::fs::File::create(dir.join("cosim.log")).unwrap();
+    let id = run_id("external_python");
     let mut cosim_run = Kill(
         Command::new(cosim())
             .current_dir(root())
@@ -268,10 +269,13 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
                 "--wait-external",
                 "60",
                 "--quiet",
+                // Paused once on the way, to look at a particle (below); a pause changes no bit of the run.
+                "--break",
+                "t>=0.1",
                 "--out",
             ])
             .arg(&out_py)
-            .args(["--run-id", &run_id("external_python")])
+            .args(["--run-id", &id])
             .stdin(Stdio::null())
             .stdout(cosim_log.try_clone().unwrap())
             .stderr(cosim_log)
@@ -290,6 +294,7 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
             .spawn()
             .unwrap(),
     );
+    look_at_a_particle_while_paused(&mut cosim_run, &id, until);
     let status = wait_exit(&mut cosim_run.0, until, "cosim run --external fem");
     let node_status = wait_exit(&mut node.0, until, "the Python node");
     let logs = || {
@@ -331,6 +336,38 @@ fn python_structure_node_matches_its_rust_twin_bit_for_bit() {
         100.0 * err
     );
     assert!(err.abs() < 0.10, "{mean} vs {statics}");
+}
+
+/// `cosim inspect --particle` on a run whose structure node is an outside program that saves no checkpoint: the
+/// particle is shown, and the structure said not to be (the whole query failed before: D25 of the 2026-12-06 sweep of
+/// hostile external nodes). Then the run goes on.
+fn look_at_a_particle_while_paused(run: &mut Kill, id: &str, until: Instant) {
+    let ask = |args: &[&str]| {
+        let out = cosim_run(args, Duration::from_secs(60));
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        let doc = serde_json::from_str(&stdout).unwrap_or(serde_json::Value::Null);
+        (out.status.code(), doc, stdout + &String::from_utf8_lossy(&out.stderr))
+    };
+    loop {
+        assert!(run.0.try_wait().unwrap().is_none(), "the run ended instead of pausing");
+        assert!(Instant::now() < until, "the run did not pause");
+        let (code, doc, _) = ask(&["ctl", id, "status"]);
+        if code == Some(0) && doc["paused"].as_str().is_some_and(|p| !p.is_empty()) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let (code, doc, text) = ask(&["inspect", id, "--particle", "0"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert_eq!(doc["particle"]["id"], 0, "{doc:#}");
+    assert!(doc["particle"]["rho"].as_f64().unwrap() > 900.0, "{doc:#}");
+    let structure = doc["structure"].as_str().unwrap_or_default();
+    assert!(
+        structure.starts_with("not shown: ") && structure.contains("fem-node"),
+        "{doc:#}"
+    );
+    let (code, _, text) = ask(&["ctl", id, "resume"]);
+    assert_eq!(code, Some(0), "{text}");
 }
 
 /// Issue 19: the conformance test for an outside code. A run of the Rust twin, recorded in this process, is replayed

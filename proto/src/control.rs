@@ -116,6 +116,40 @@ pub struct ControlReply {
     pub paused: String,
 }
 
+/// Whose checkpoints a state query asks for: the selector parameter `nodes` of `cosim/<run>/broker/state`
+/// (`docs/PROTOCOL.md` §11). Without it, every node's; `nodes=sph`, the fluid node's alone, as `cosim inspect
+/// --particle` asks again where the structure node cannot save one (an outside program in its place): the whole query
+/// failed with it before (found 2026-12-06 by the sweep of hostile external nodes, D25).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateOf {
+    /// Every node of the run.
+    All,
+    /// The fluid node alone; `fem` comes back empty.
+    Fluid,
+}
+
+impl StateOf {
+    /// The selector parameter's name.
+    pub const PARAMETER: &'static str = "nodes";
+
+    /// The selector's parameters that ask for `self` (`""` for every node).
+    pub fn parameters(self) -> &'static str {
+        match self {
+            Self::All => "",
+            Self::Fluid => "nodes=sph",
+        }
+    }
+
+    /// From the parameter's value (`None`: absent).
+    pub fn parse(value: Option<&str>) -> Result<Self, String> {
+        match value {
+            None | Some("all") => Ok(Self::All),
+            Some("sph") => Ok(Self::Fluid),
+            Some(other) => Err(format!("nodes={other}: ask for `all` or `sph`")),
+        }
+    }
+}
+
 /// The state of a run between two steps (`cosim/<run>/broker/state`, an envelope whose step and t are those of
 /// the last step done): every node's checkpoint and the corrections of the last contact pass, still to be sent.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

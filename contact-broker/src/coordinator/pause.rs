@@ -7,7 +7,7 @@
 
 use std::time::Duration;
 
-use cosim_proto::control::{BreakCondition, ContactRecord, ControlCommand, ControlReply, DebugState};
+use cosim_proto::control::{BreakCondition, ContactRecord, ControlCommand, ControlReply, DebugState, StateOf};
 
 use super::inputs::Nodes;
 use crate::interface::Corrections;
@@ -63,12 +63,12 @@ impl<'a, 'n> Halt<'a, 'n> {
         }
     }
 
-    /// Every node's state now (their checkpoints, asked for as a checkpoint asks: between two steps, read only)
-    /// and the corrections of the last contact pass.
-    pub fn state(&mut self) -> Result<DebugState, LinkError> {
+    /// The nodes' state now (their checkpoints, asked for as a checkpoint asks: between two steps, read only; the
+    /// structure's only where `of` asks for it) and the corrections of the last contact pass.
+    pub fn state(&mut self, of: StateOf) -> Result<DebugState, LinkError> {
         let fem = match self.nodes.fem.as_deref_mut() {
-            Some(link) => link.checkpoint(self.step)?,
-            None => Vec::new(),
+            Some(link) if of == StateOf::All => link.checkpoint(self.step)?,
+            _ => Vec::new(),
         };
         let sph = match self.nodes.sph.as_deref_mut() {
             Some(link) => link.checkpoint(self.step)?,
@@ -350,6 +350,58 @@ mod tests {
             "paused at step 1: paused by `cosim ctl pause`"
         );
         assert_eq!(script.shown, ["paused at step 1: paused by `cosim ctl pause`"]);
+    }
+
+    /// `nodes=sph` (`StateOf::Fluid`): the fluid's checkpoint alone, where the structure node cannot save one (an
+    /// outside program), which makes the whole state fail.
+    #[test]
+    fn the_fluids_state_alone_is_given_where_the_structure_cannot_checkpoint() {
+        use cosim_proto::messages::{FemMesh, FemState, SphSetup, SphState};
+
+        use crate::link::InProcess;
+
+        let mesh = FemMesh {
+            solid_names: vec!["plate".into()],
+            nodes: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            masses: vec![1.0; 3],
+            node_solid: vec![0; 3],
+            cells: vec![vec![0, 1, 2]],
+            cell_solid: vec![0],
+            interface: Vec::new(),
+            fixed: Vec::new(),
+            dt_stable: 1e-4,
+        };
+        let setup = SphSetup {
+            particles: 1,
+            spacing: 0.01,
+            h: 0.013,
+            density: 1000.0,
+            walls: Vec::new(),
+            dt_stable: 1e-4,
+            sensors: 0,
+        };
+        // A structure without a checkpoint, as an outside node's link is; a fluid that saves three bytes.
+        let mut fem = InProcess::<FemMesh, FemState>::new(mesh, |_| Ok(None));
+        let mut sph = InProcess::<SphSetup, SphState>::new(setup, |_| Ok(None)).with_checkpoint(|| Ok(vec![1, 2, 3]));
+        let mut nodes = Nodes {
+            fem: Some(&mut fem),
+            sph: Some(&mut sph),
+        };
+        let pending = Corrections::default();
+        let mut halt = Halt::new(4, 0.04, 0.0, &pending, None, &mut nodes);
+        let whole = halt.state(StateOf::All).unwrap_err().to_string();
+        assert!(whole.contains("cannot save a checkpoint"), "{whole}");
+        let fluid = halt.state(StateOf::Fluid).unwrap();
+        assert_eq!((fluid.fem, fluid.sph), (Vec::new(), vec![1, 2, 3]));
+        assert_eq!(
+            StateOf::parse(Some(StateOf::Fluid.parameters().trim_start_matches("nodes="))),
+            Ok(StateOf::Fluid)
+        );
+        assert_eq!(StateOf::parse(None), Ok(StateOf::All));
+        assert_eq!(
+            StateOf::parse(Some("fem")),
+            Err("nodes=fem: ask for `all` or `sph`".into())
+        );
     }
 
     #[test]
