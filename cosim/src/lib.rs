@@ -8,6 +8,7 @@
 pub mod bench;
 pub mod check;
 pub mod cli;
+pub mod closed_stdout;
 pub mod compare;
 pub mod ctl;
 pub mod in_process;

@@ -6,6 +6,7 @@ use clap::Parser;
 use cosim::cli::{Cli, Command};
 
 fn main() -> ExitCode {
+    cosim::closed_stdout::quiet_on_closed_stdout();
     let cli = Cli::parse();
     // `cosim run` opens a zenoh session only to ask whether its run id is live (`run::run`); zenoh's own lines about
     // a router it cannot join are the broker's to log, in its log file, and its one line says what went wrong.

@@ -7,6 +7,29 @@ use std::time::Duration;
 
 use common::*;
 
+/// A reader that closes the output early (`cosim check … | head -1`) ends the command without a panic's report
+/// (`cosim::closed_stdout`); it printed "failed printing to stdout: Broken pipe" and a backtrace before.
+#[test]
+fn a_closed_output_ends_the_command_quietly() {
+    use std::process::{Command, Stdio};
+
+    let mut child = Command::new(cosim())
+        .args(["check", root().join("scenes/csm3.toml").to_str().unwrap()])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reading end closed before anything is written.
+    drop(child.stdout.take());
+    let until = std::time::Instant::now() + Duration::from_secs(30);
+    let status = wait_exit(&mut child, until, "cosim check");
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+    assert!(!status.success(), "it cannot have printed what it checked");
+    assert_eq!(stderr, "", "nothing said on stderr for a closed pipe");
+}
+
 #[test]
 fn check_prints_what_would_run() {
     let out = cosim_run(
