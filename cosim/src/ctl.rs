@@ -79,10 +79,18 @@ fn wait_paused(session: &Session, id: &str, timeout: Duration, first: ControlRep
             Ok(reply) => last = reply,
             Err(e) => {
                 last.ok = false;
-                last.message = format!(
-                    "the run did not pause again after {:.1} s: {e:#}",
-                    started.elapsed().as_secs_f64()
-                );
+                let waited = started.elapsed().as_secs_f64();
+                // A run that reached its end before the steps asked were taken: its broker's token is gone (`cosim
+                // ctl RUN step N` beyond the run's end said only that the broker "did not answer within 10 s").
+                let alive = key(id, topic::BROKER_ALIVE);
+                last.message = match cosim_bus::claim::held(session, &alive, Duration::from_secs(2)) {
+                    Ok(false) => format!(
+                        "the run ended before pausing again (its broker is gone; last seen at step {}, t = {} s)",
+                        last.step,
+                        cosim_proto::Num(last.t)
+                    ),
+                    _ => format!("the run did not pause again after {waited:.1} s: {e:#}"),
+                };
                 break;
             }
         }
