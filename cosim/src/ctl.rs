@@ -87,7 +87,7 @@ fn wait_paused(session: &Session, id: &str, timeout: Duration, first: ControlRep
                     Ok(false) => format!(
                         "the run ended before pausing again (its broker is gone; last seen at step {}, t = {} s)",
                         last.step,
-                        cosim_proto::Num(last.t)
+                        cosim_proto::Num(cosim_proto::readable::significant(last.t, 12))
                     ),
                     _ => format!("the run did not pause again after {waited:.1} s: {e:#}"),
                 };

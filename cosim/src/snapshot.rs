@@ -45,7 +45,8 @@ pub fn snapshot(args: &SnapshotArgs) -> anyhow::Result<ExitCode> {
         "snapshot of run {} at step {} (t = {} s{}): {} contact(s) -> {}",
         args.id,
         look.step,
-        look.t,
+        // The sum of the run's steps: 0.30000000000000004 reads 0.3 at 12 digits.
+        cosim_proto::Num(cosim_proto::readable::significant(look.t, 12)),
         if look.paused.is_empty() {
             String::new()
         } else {
