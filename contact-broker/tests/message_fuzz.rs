@@ -631,6 +631,28 @@ fn a_state_no_run_reaches_is_its_senders_blow_up() {
                 "-100000000000.0]: 1e11 m/s, faster than any run of the scene moves",
             ][..],
         ),
+        // Far from anywhere a run of the scene reaches, at a plausible speed (D12: a structure at 1e10 m was taken):
+        // the plate's scene starts within 2.1 m and moves at most 50 km/s for 1.2 ms, 60 m.
+        (
+            Spoil::Fem {
+                step: 3,
+                how: FemSpoil::X(0, 1e9),
+            },
+            &[
+                "fem-node: sent an unusable message: fem/state x[0] = [1000000000.0, ",
+                "farther than any run of the scene reaches (x in -60",
+            ][..],
+        ),
+        (
+            Spoil::Sph {
+                step: 2,
+                how: SphSpoil::X(-1e9),
+            },
+            &[
+                "sph-node: sent an unusable message: sph/state x[0] = [",
+                "-1000000000.0]: farther than any run of the scene reaches",
+            ][..],
+        ),
     ];
     for (spoil, wants) in cases {
         let (status, message, _) = run_spoilt(&spoil);

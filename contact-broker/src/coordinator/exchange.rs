@@ -8,7 +8,7 @@ use anyhow::Context;
 use cosim_proto::messages::{FemState, SphState, StepCommand};
 use cosim_proto::readable::significant;
 use cosim_proto::scene::Scene;
-use cosim_proto::validate::{speed_limit, Asked, Invalid};
+use cosim_proto::validate::{speed_limit, Asked, Invalid, Reach};
 use cosim_proto::Num;
 
 use super::inputs::Nodes;
@@ -67,8 +67,8 @@ pub(super) fn check_registrations(scene: &Scene, nodes: &Nodes<'_>) -> anyhow::R
 pub(super) struct Expected {
     /// The ids of the structure's interface nodes, which its answers report ([`cosim_proto::messages::FemMesh::interface_nodes`]).
     interface_ids: Vec<u32>,
-    /// The fastest a node may report a particle or a node moving ([`speed_limit`]).
-    speed_limit: f64,
+    /// How fast and how far a node may report a particle or a node ([`Reach`]).
+    reach: Reach,
 }
 
 impl Expected {
@@ -83,14 +83,43 @@ impl Expected {
             .solids
             .iter()
             .map(|s| (s.material.youngs_modulus / s.material.density).sqrt());
+        let mesh = nodes.fem.as_ref().map(|f| f.setup());
         Self {
-            interface_ids: nodes
-                .fem
-                .as_ref()
-                .map_or_else(Vec::new, |f| f.setup().interface_nodes()),
-            speed_limit: speed_limit(c0, solids),
+            interface_ids: mesh.map_or_else(Vec::new, |m| m.interface_nodes()),
+            reach: Reach::new(speed_limit(c0, solids), start(scene, nodes), scene.run.end_time),
         }
     }
+}
+
+/// The box the run starts in: the scene's walls, fluid blocks and solids, and the points the nodes registered (the
+/// structure's nodes, the wall particles); the whole plane where there are none.
+fn start(scene: &Scene, nodes: &Nodes<'_>) -> ([f64; 2], [f64; 2]) {
+    let boxes = (scene.walls.iter().chain(scene.fluid.iter().flat_map(|f| &f.blocks)))
+        .map(|b| (b.min, b.max))
+        .chain(scene.solids.iter().map(|s| (s.min, s.max)));
+    let points = (nodes
+        .fem
+        .as_ref()
+        .map(|f| f.setup().nodes.as_slice())
+        .unwrap_or_default()
+        .iter())
+    .chain(
+        nodes
+            .sph
+            .as_ref()
+            .map(|s| s.setup().walls.as_slice())
+            .unwrap_or_default(),
+    )
+    .map(|&p| (p, p));
+    let grown = boxes
+        .chain(points)
+        .fold(None, |acc: Option<([f64; 2], [f64; 2])>, (lo, hi)| {
+            Some(match acc {
+                None => (lo, hi),
+                Some((a, b)) => ([a[0].min(lo[0]), a[1].min(lo[1])], [b[0].max(hi[0]), b[1].max(hi[1])]),
+            })
+        });
+    grown.unwrap_or(([f64::NEG_INFINITY; 2], [f64::INFINITY; 2]))
 }
 
 /// How many times the scene's solids' perimeter a coupled structure's registered surface may be long.
@@ -198,7 +227,7 @@ pub(super) fn exchange(
         interface: cmd.want_interface,
         snapshot: cmd.want_snapshot,
         interface_ids: &expected.interface_ids,
-        speed_limit: expected.speed_limit,
+        reach: expected.reach,
     };
     let (fem_asked, sph_asked) = (asked(&fem_cmd), asked(&sph_cmd));
     let started = Instant::now();

@@ -29,8 +29,8 @@ pub enum Kind {
     Inconsistent,
     /// A NaN, an infinity or a number beyond ±[`LARGEST`] where a state holds numbers: the sender blew up.
     NonFinite,
-    /// A state no run of the scene can reach, though its numbers are finite: a speed beyond [`Asked::speed_limit`],
-    /// a surface segment collapsed to a point. The sender blew up.
+    /// A state no run of the scene can reach, though its numbers are finite: a speed or a position beyond
+    /// [`Asked::reach`], a surface segment collapsed to a point. The sender blew up.
     Implausible,
 }
 
@@ -135,27 +135,6 @@ impl Check {
         Ok(())
     }
 
-    /// Every velocity of `vs` no faster than `limit` ([`Asked::speed_limit`]).
-    fn speeds(self, field: &'static str, vs: &[[f64; 2]], limit: f64) -> Result {
-        match vs.iter().position(|v| v[0].hypot(v[1]) > limit) {
-            None => Ok(()),
-            Some(i) => Err(Invalid {
-                kind: Kind::Implausible,
-                ..self.fail(
-                    field,
-                    &[i],
-                    format!("{:?}", vs[i]),
-                    format!(
-                        "{} m/s, faster than any run of the scene moves ({} m/s: {SPEED_LIMIT_FACTOR} times its \
-                         fastest wave speed)",
-                        crate::Num(crate::readable::significant(vs[i][0].hypot(vs[i][1]), 6)),
-                        crate::Num(limit)
-                    ),
-                )
-            }),
-        }
-    }
-
     fn values(self, field: &'static str, xs: &[f64]) -> Result {
         xs.iter()
             .enumerate()
@@ -209,32 +188,8 @@ pub struct Asked<'a> {
     pub snapshot: bool,
     /// For the structure: the ids of the mesh's interface nodes ([`FemMesh::interface_nodes`]).
     pub interface_ids: &'a [u32],
-    /// The fastest a particle or a node of the answer may move [m/s] ([`speed_limit`]; infinite: no limit).
-    pub speed_limit: f64,
-}
-
-/// How many times the scene's fastest wave speed a state may move at most ([`speed_limit`]).
-pub const SPEED_LIMIT_FACTOR: f64 = 10.0;
-
-/// The fastest a fluid particle or a structure node of a run may move: [`SPEED_LIMIT_FACTOR`] times the fastest
-/// wave speed of the scene, the fluid's sound speed `c0` (where it has one) or a solid's bar wave speed √(E/ρ)
-/// (`solid_wave_speeds`). Nothing a run can reach comes near it: a weakly compressible fluid's model holds below a
-/// tenth of `c0` (`DESIGN.md` §4.2, c0 ≥ 10 v_max), and a node moving at its solid's wave speed strains it by order
-/// one. A node that reports more has blown up, though its numbers are finite: found 2026-12-06 by a sweep of
-/// hostile external nodes, a structure reporting 1e20 m/s, or one whose spring flung it at 1e11 m/s, blew up the
-/// fluid node, which took the blame, or made the coupling step crawl (1e5 steps to reach t = 0.0006 s). Infinite
-/// where the scene gives no wave speed.
-pub fn speed_limit(c0: Option<f64>, solid_wave_speeds: impl IntoIterator<Item = f64>) -> f64 {
-    let fastest = solid_wave_speeds
-        .into_iter()
-        .chain(c0)
-        .filter(|c| c.is_finite() && *c > 0.0)
-        .fold(0.0, f64::max);
-    if fastest > 0.0 {
-        SPEED_LIMIT_FACTOR * fastest
-    } else {
-        f64::INFINITY
-    }
+    /// How fast and how far a particle or a node of the answer may be ([`Reach`]).
+    pub reach: Reach,
 }
 
 impl FemState {
@@ -257,12 +212,13 @@ impl FemState {
         c.len("v", self.v.len(), self.ids.len(), "id")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
-        c.speeds("v", &self.v, asked.speed_limit)?;
+        c.speeds("v", &self.v, &asked.reach)?;
+        c.positions("x", &self.x, &asked.reach)?;
         self.check_segments(c, mesh)?;
         c.step("dt_stable", self.dt_stable)?;
         c.seconds("compute_seconds", self.compute_seconds)?;
         match &self.snapshot {
-            Some(s) => s.validate(mesh, asked.speed_limit),
+            Some(s) => s.validate(mesh, &asked.reach),
             None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
             None => Ok(()),
         }
@@ -293,8 +249,8 @@ impl FemState {
 }
 
 impl FemSnapshot {
-    /// Check a structure snapshot against the mesh it is of, its nodes no faster than `speed_limit`.
-    pub fn validate(&self, mesh: &FemMesh, speed_limit: f64) -> Result {
+    /// Check a structure snapshot against the mesh it is of, its nodes within `reach`.
+    pub fn validate(&self, mesh: &FemMesh, reach: &Reach) -> Result {
         let c = Check("fem/state snapshot");
         c.len("x", self.x.len(), mesh.nodes.len(), "node")?;
         c.len("v", self.v.len(), mesh.nodes.len(), "node")?;
@@ -302,7 +258,8 @@ impl FemSnapshot {
         c.len("energies", self.energies.len(), mesh.solid_names.len(), "solid")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
-        c.speeds("v", &self.v, speed_limit)?;
+        c.speeds("v", &self.v, reach)?;
+        c.positions("x", &self.x, reach)?;
         c.points("stress", &self.stress)?;
         let energies: Vec<[f64; 3]> = self
             .energies
@@ -343,14 +300,15 @@ impl SphState {
         c.len("m", self.m.len(), self.ids.len(), "id")?;
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
-        c.speeds("v", &self.v, asked.speed_limit)?;
+        c.speeds("v", &self.v, &asked.reach)?;
+        c.positions("x", &self.x, &asked.reach)?;
         for (k, m) in self.m.iter().enumerate() {
             c.positive("m", &[k], *m)?;
         }
         c.step("dt_stable", self.dt_stable)?;
         c.seconds("compute_seconds", self.compute_seconds)?;
         match &self.snapshot {
-            Some(s) => s.validate(setup, asked.speed_limit),
+            Some(s) => s.validate(setup, &asked.reach),
             None if asked.snapshot => Err(c.fail("snapshot", &[], "none", "asked for at an output time")),
             None => Ok(()),
         }
@@ -358,8 +316,8 @@ impl SphState {
 }
 
 impl SphSnapshot {
-    /// Check a fluid snapshot against the registration it belongs to, its particles no faster than `speed_limit`.
-    pub fn validate(&self, setup: &SphSetup, speed_limit: f64) -> Result {
+    /// Check a fluid snapshot against the registration it belongs to, its particles within `reach`.
+    pub fn validate(&self, setup: &SphSetup, reach: &Reach) -> Result {
         let c = Check("sph/state snapshot");
         let n = setup.particles as usize;
         for (field, len) in [
@@ -381,7 +339,8 @@ impl SphSnapshot {
         }
         c.points("x", &self.x)?;
         c.points("v", &self.v)?;
-        c.speeds("v", &self.v, speed_limit)?;
+        c.speeds("v", &self.v, reach)?;
+        c.positions("x", &self.x, reach)?;
         c.values("p", &self.p)?;
         c.values("wall_p", &self.wall_p)?;
         for (k, rho) in self.rho.iter().enumerate() {
@@ -453,5 +412,8 @@ fn validate_corrections(c: Check, corrections: &[Correction], count: usize, face
 }
 
 mod mesh;
+mod reach;
+
+pub use reach::{speed_limit, Reach, SPEED_LIMIT_FACTOR};
 #[cfg(test)]
 mod tests;

@@ -119,7 +119,7 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
         interface: true,
         snapshot: false,
         interface_ids: &ids,
-        speed_limit: f64::INFINITY,
+        reach: Reach::ANY,
     };
     let state = FemState {
         ids: ids.clone(),
@@ -176,7 +176,10 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
     // A speed no run of the scene reaches (D12 of the sweep: 1e20 m/s blew up the fluid node, which took the blame)
     // is the sender's blow-up, finite or not; a speed at the limit passes.
     let limited = Asked {
-        speed_limit: 100.0,
+        reach: Reach {
+            speed: 100.0,
+            ..Reach::ANY
+        },
         ..asked
     };
     let mut flung = state.clone();
@@ -201,6 +204,23 @@ fn a_state_must_report_exactly_the_interface_it_was_asked_for() {
             "fem/state x = {:?} for nodes 0 and 1: interface segment 0 collapsed to a point",
             state.x[0]
         )
+    );
+    // A position no run of the scene reaches (D12: a structure at 1e10 m with a plausible speed was taken): the box
+    // where it starts (the unit square) grown by 100 m/s over 0.5 s; its edge passes.
+    let far = Asked {
+        reach: Reach::new(100.0, ([0.0, 0.0], [1.0, 1.0]), 0.5),
+        ..asked
+    };
+    let mut moved = state.clone();
+    moved.x[3] = [-50.0, 51.0];
+    assert_eq!(moved.validate(&m, far), Ok(()));
+    moved.x[3] = [1e10, 0.5];
+    let e = moved.validate(&m, far).unwrap_err();
+    assert!(e.blew_up() && !e.is_non_finite());
+    assert_eq!(
+        e.to_string(),
+        "fem/state x[3] = [10000000000.0, 0.5]: farther than any run of the scene reaches (x in -50…51 m, y in -50…51 \
+         m: where it starts, grown by 10 times its fastest wave speed over its end time)"
     );
     let no_snapshot = Asked {
         snapshot: true,
@@ -227,7 +247,7 @@ fn fluid_ids_must_be_in_range_ascending_and_once() {
         interface: true,
         snapshot: false,
         interface_ids: &[],
-        speed_limit: f64::INFINITY,
+        reach: Reach::ANY,
     };
     let state = |ids: Vec<u32>| SphState {
         x: vec![[0.0; 2]; ids.len()],
@@ -251,7 +271,10 @@ fn fluid_ids_must_be_in_range_ascending_and_once() {
     let mut fast = state(vec![1]);
     fast.v[0] = [0.0, -1e20];
     let limited = Asked {
-        speed_limit: 240.0,
+        reach: Reach {
+            speed: 240.0,
+            ..Reach::ANY
+        },
         ..asked
     };
     assert_eq!(
@@ -345,6 +368,15 @@ fn a_correction_s_face_is_checked() {
 }
 
 /// The limit is ten times the fastest of the fluid's sound speed and the solids' bar wave speeds; none without one.
+#[test]
+fn the_reach_is_the_start_grown_by_the_speed_over_the_end_time() {
+    let r = Reach::new(240.0, ([0.0, -1.0], [2.0, 0.5]), 0.25);
+    assert_eq!((r.min, r.max, r.speed), ([-60.0, -61.0], [62.0, 60.5], 240.0));
+    // No wave speed, or an end time that makes it infinite: no bound.
+    assert_eq!(Reach::new(f64::INFINITY, ([0.0; 2], [1.0; 2]), 1.0), Reach::ANY);
+    assert_eq!(Reach::new(1e300, ([0.0; 2], [1.0; 2]), 1e300).max, [f64::INFINITY; 2]);
+}
+
 #[test]
 fn the_speed_limit_is_ten_times_the_fastest_wave_speed() {
     assert_eq!(speed_limit(Some(24.0), [104.0, 3.0]), 1040.0);
