@@ -18,6 +18,7 @@ pub mod probes;
 pub mod recorder;
 pub mod relaxation;
 pub mod remote_control;
+pub mod served;
 pub mod setup;
 pub mod step_budget;
 pub mod summary;

@@ -1,11 +1,12 @@
-//! The broker's zenoh side: session, the `scene` queryable, node registration and the per-step exchange with a
-//! structure node in another process. Everything the coordinator needs is behind [`FemLink`].
+//! The broker's zenoh side: session, node registration and the per-step exchange with a node in another process
+//! (the queryables it answers beside the steps, the scene and the restore states, are in `served.rs`). Everything
+//! the coordinator needs is behind [`NodeLink`].
 
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use cosim_proto::envelope::{CodecError, Envelope};
-use cosim_proto::keys::{key, topic, NodeTopics};
+use cosim_proto::keys::{key, NodeTopics};
 use cosim_proto::messages::{NodeCheckpoint, NodeError, StepCommand};
 use cosim_proto::run_status::RunStatus;
 use serde::de::DeserializeOwned;
@@ -13,7 +14,6 @@ use zenoh::bytes::ZBytes;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
-use zenoh::query::Queryable;
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
 
@@ -24,43 +24,10 @@ use cosim_bus::link_loss;
 use cosim_bus::refusals::Refusals;
 use cosim_proto::trace::Kind;
 
+pub use crate::served::{serve_restore, serve_scene};
 pub use cosim_bus::session::{
     open_client, open_client_from, open_listening, open_listening_from, open_session, open_session_from,
 };
-
-/// Answer `cosim/<run>/scene` with the resolved scene (TOML text) for as long as the returned handle lives.
-pub fn serve_scene(session: &Session, run: &str, scene_toml: String) -> anyhow::Result<Queryable<()>> {
-    session
-        .declare_queryable(key(run, topic::SCENE))
-        .callback(move |query| {
-            if let Err(e) = query.reply(query.key_expr().clone(), scene_toml.clone()).wait() {
-                tracing::warn!("scene query: {e}");
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("{e}"))
-}
-
-/// Answer `cosim/<run>/<node>/restore` (`docs/PROTOCOL.md` §9) for as long as the returned handle lives: the
-/// node's state saved at step `step` (time `t`) when the run continues from a checkpoint, else an empty state
-/// (start from the scene).
-pub fn serve_restore(
-    session: &Session,
-    run: &str,
-    topics: NodeTopics,
-    saved: Option<(u64, f64, Vec<u8>)>,
-) -> anyhow::Result<Queryable<()>> {
-    let bytes = crate::checkpoint::restore_reply::restore_reply(run, topics, saved)?;
-    session
-        .declare_queryable(key(run, topics.restore))
-        .callback(move |query| {
-            if let Err(e) = query.reply(query.key_expr().clone(), bytes.clone()).wait() {
-                tracing::warn!("restore query: {e}");
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("{e}"))
-}
 
 type Sub = Subscriber<FifoChannelHandler<Sample>>;
 
