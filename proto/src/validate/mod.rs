@@ -53,6 +53,14 @@ pub struct Invalid {
 }
 
 impl Invalid {
+    /// The same, as a state no run of the scene reaches ([`Kind::Implausible`]): its sender blew up.
+    fn implausible(self) -> Self {
+        Self {
+            kind: Kind::Implausible,
+            ..self
+        }
+    }
+
     /// True when the message holds a NaN or an infinity where a state holds numbers: the sender blew up.
     pub fn is_non_finite(&self) -> bool {
         self.kind == Kind::NonFinite
@@ -232,15 +240,14 @@ impl FemState {
         for (i, Segment { a, b }) in mesh.interface.iter().enumerate() {
             if let (Some(pa), Some(pb)) = (at(*a), at(*b)) {
                 if pa == pb {
-                    return Err(Invalid {
-                        kind: Kind::Implausible,
-                        ..c.fail(
+                    return Err(c
+                        .fail(
                             "x",
                             &[],
                             format!("{pa:?} for nodes {a} and {b}"),
                             format!("interface segment {i} collapsed to a point"),
                         )
-                    });
+                        .implausible());
                 }
             }
         }

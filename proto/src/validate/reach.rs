@@ -2,7 +2,7 @@
 //! finite (`docs/PROTOCOL.md` §7). The speed is bounded by the scene's fastest wave speed, the position by where the
 //! scene starts grown by that speed over the run's end time.
 
-use super::{Check, Invalid, Kind, Result};
+use super::{Check, Result};
 use crate::readable::significant;
 use crate::Num;
 
@@ -75,9 +75,8 @@ impl Check {
         let limit = reach.speed;
         match vs.iter().position(|v| v[0].hypot(v[1]) > limit) {
             None => Ok(()),
-            Some(i) => Err(Invalid {
-                kind: Kind::Implausible,
-                ..self.fail(
+            Some(i) => Err(self
+                .fail(
                     field,
                     &[i],
                     format!("{:?}", vs[i]),
@@ -88,7 +87,7 @@ impl Check {
                         Num(limit)
                     ),
                 )
-            }),
+                .implausible()),
         }
     }
 
@@ -97,9 +96,8 @@ impl Check {
         let inside = |x: &[f64; 2]| (0..2).all(|k| x[k] >= reach.min[k] && x[k] <= reach.max[k]);
         match xs.iter().position(|x| !inside(x)) {
             None => Ok(()),
-            Some(i) => Err(Invalid {
-                kind: Kind::Implausible,
-                ..self.fail(
+            Some(i) => Err(self
+                .fail(
                     field,
                     &[i],
                     format!("{:?}", xs[i]),
@@ -112,7 +110,7 @@ impl Check {
                         Num(significant(reach.max[1], 6))
                     ),
                 )
-            }),
+                .implausible()),
         }
     }
 }
