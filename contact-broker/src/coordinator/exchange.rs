@@ -84,42 +84,34 @@ impl Expected {
             .iter()
             .map(|s| (s.material.youngs_modulus / s.material.density).sqrt());
         let mesh = nodes.fem.as_ref().map(|f| f.setup());
+        let walls = nodes.sph.as_ref().map_or(&[][..], |s| &s.setup().walls);
+        let start = start(scene, mesh.map_or(&[][..], |m| &m.nodes), walls);
         Self {
             interface_ids: mesh.map_or_else(Vec::new, |m| m.interface_nodes()),
-            reach: Reach::new(speed_limit(c0, solids), start(scene, nodes), scene.run.end_time),
+            reach: Reach::new(speed_limit(c0, solids), start, scene.run.end_time),
         }
     }
 }
 
 /// The box the run starts in: the scene's walls, fluid blocks and solids, and the points the nodes registered (the
-/// structure's nodes, the wall particles); the whole plane where there are none.
-fn start(scene: &Scene, nodes: &Nodes<'_>) -> ([f64; 2], [f64; 2]) {
+/// structure's nodes `mesh`, the wall particles `walls`); the whole plane where there are none.
+fn start(scene: &Scene, mesh: &[[f64; 2]], walls: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
     let boxes = (scene.walls.iter().chain(scene.fluid.iter().flat_map(|f| &f.blocks)))
         .map(|b| (b.min, b.max))
-        .chain(scene.solids.iter().map(|s| (s.min, s.max)));
-    let points = (nodes
-        .fem
-        .as_ref()
-        .map(|f| f.setup().nodes.as_slice())
-        .unwrap_or_default()
-        .iter())
-    .chain(
-        nodes
-            .sph
-            .as_ref()
-            .map(|s| s.setup().walls.as_slice())
-            .unwrap_or_default(),
-    )
-    .map(|&p| (p, p));
-    let grown = boxes
-        .chain(points)
-        .fold(None, |acc: Option<([f64; 2], [f64; 2])>, (lo, hi)| {
-            Some(match acc {
-                None => (lo, hi),
-                Some((a, b)) => ([a[0].min(lo[0]), a[1].min(lo[1])], [b[0].max(hi[0]), b[1].max(hi[1])]),
-            })
-        });
-    grown.unwrap_or(([f64::NEG_INFINITY; 2], [f64::INFINITY; 2]))
+        .chain(scene.solids.iter().map(|s| (s.min, s.max)))
+        .chain(mesh.iter().chain(walls).map(|&p| (p, p)));
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for (a, b) in boxes {
+        for k in 0..2 {
+            lo[k] = lo[k].min(a[k]);
+            hi[k] = hi[k].max(b[k]);
+        }
+    }
+    if lo[0] <= hi[0] {
+        (lo, hi)
+    } else {
+        ([f64::NEG_INFINITY; 2], [f64::INFINITY; 2])
+    }
 }
 
 /// How many times the scene's solids' perimeter a coupled structure's registered surface may be long.

@@ -106,12 +106,7 @@ impl FemMesh {
     fn signed_area(&self, ids: impl Iterator<Item = u32> + Clone) -> f64 {
         let at = |id: u32| self.nodes.get(id as usize).copied().unwrap_or([f64::NAN; 2]);
         let next = ids.clone().cycle().skip(1);
-        ids.zip(next)
-            .map(|(a, b)| {
-                let (pa, pb) = (at(a), at(b));
-                0.5 * (pa[0] * pb[1] - pa[1] * pb[0])
-            })
-            .sum()
+        ids.zip(next).map(|(a, b)| shoelace(&at(a), &at(b))).sum()
     }
 
     /// The contact's geometry (ids already checked): every segment has a length, and each solid's segments go
@@ -140,7 +135,7 @@ impl FemMesh {
             };
             slot.1 = true;
             if self.node_solid.get(*b as usize) == solid {
-                slot.0 += 0.5 * (pa[0] * pb[1] - pa[1] * pb[0]);
+                slot.0 += shoelace(pa, pb);
             }
         }
         for ((s, &(a, has)), name) in area.iter().enumerate().zip(&self.solid_names) {
@@ -182,4 +177,9 @@ impl FemMesh {
         }
         Ok(())
     }
+}
+
+/// The edge a → b's term of a polygon's signed area, (x_a × x_b)/2.
+fn shoelace(a: &[f64; 2], b: &[f64; 2]) -> f64 {
+    0.5 * (a[0] * b[1] - a[1] * b[0])
 }
