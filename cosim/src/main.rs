@@ -1,4 +1,4 @@
-//! `cosim`: run, check, compare, bench, inspect, router.
+//! `cosim`: run, check, compare, inspect, ctl, snapshot, replay, bench, router.
 
 use std::process::ExitCode;
 

@@ -2,7 +2,7 @@
 //! "Contents"): an outside program registers as the structure node with a mesh the broker cannot use. The broker
 //! used to index it and panic (exit 101; the summary said only "contact-broker died"); it now ends the run `failed`
 //! with one line naming the node, the message, the field, the index and the value, and writes `summary.json`.
-//! The same checks on every message type, in-process and fuzzed, are in `contact-broker/tests/message_fuzz.rs`.
+//! The same checks on every message type, in-process and fuzzed, are in `contact-broker/tests/message_fuzz/`.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! No WCSPH fluid particle is ever inside a wall: the tall dam break of `cosim/tests/stress.rs` (a 0.1 × 0.3 m
+//! No WCSPH fluid particle is ever inside a wall: the tall dam break of `cosim/tests/stress/` (a 0.1 × 0.3 m
 //! column at Δx = 10 mm slamming into the far wall of a closed 0.3 m tank), stepped as `cosim run` steps it (1 ms
 //! coupling steps, each in as many stable steps as it takes), to t = 2.5 s, with every particle checked after every
 //! step against every `[[wall]]` box (grown as the wall particles fill it).

@@ -119,7 +119,7 @@ fn cases_section(md: &mut String, cases: &[Case]) {
                 }
                 Metric::Stress => {
                     "; each must end `ok` with every probe sample finite and `energy_growth` ≤ 0.05 (the bound of \
-                     `cosim/tests/stress.rs`), or be stopped `unstable` by a guard with a reason"
+                     `cosim/tests/stress/`), or be stopped `unstable` by a guard with a reason"
                 }
                 Metric::Scaling => {
                     "; the WCSPH dam break at ~5,000 to ~100,000 particles for ~60 steps (quick) or ~200 (full), \

@@ -282,7 +282,7 @@ pub fn describe(metric: Metric) -> &'static str {
     }
 }
 
-/// The tall dam break of the stress tests (`cosim/tests/stress.rs`): the dam-break scene with a 0.1 m × 0.3 m
+/// The tall dam break of the stress tests (`cosim/tests/stress/`): the dam-break scene with a 0.1 m × 0.3 m
 /// column in a closed tank 0.3 m wide and 0.6 m high, walls 0.03 m thick.
 const TALL_DAM_BREAK: [&str; 8] = [
     "fluid.block.max=[0.1,0.3]",
@@ -313,7 +313,7 @@ const STILL_TANK: [&str; 10] = [
 /// The fluid's total energy as the gate's second probe.
 const GATE_ENERGY: &str = "probe[1]={name=\"energy\",kind=\"energy\",part=\"total\",of=\"fluid\"}";
 
-/// The stress cases: the longer variants of `cosim/tests/stress.rs` (each must end `ok` with its energy within
+/// The stress cases: the longer variants of `cosim/tests/stress/` (each must end `ok` with its energy within
 /// the budget, or be stopped `unstable` by a guard; `report.md` and `docs/PERFORMANCE.md` give the bounds).
 fn stress(scenes: &Path, quick: bool) -> Vec<Case> {
     let mut cases = Vec::new();

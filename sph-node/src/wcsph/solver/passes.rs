@@ -21,7 +21,7 @@ impl WcsphSolver {
     /// Without it a position correction moves a particle without any change of density: the contact, which puts
     /// every particle it finds inside the structure back on the same line r_c in front of its face, stacked particles
     /// up in front of the elastic gate's tip at Δx = 5 mm (some 20 in a few mm², at pressures of a few kPa), until the
-    /// stack blew apart and the energy guard stopped the run (`cosim/tests/stress.rs`,
+    /// stack blew apart and the energy guard stopped the run (`cosim/tests/stress/`,
     /// `coarse_elastic_gate_keeps_its_water_on_the_floor`).
     pub(super) fn density_follows_edits(&mut self) {
         let nf = self.state.len();
