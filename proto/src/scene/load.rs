@@ -105,6 +105,21 @@ fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> SceneError {
     SceneError::new(file, key, e.message().replace('\n', " "))
 }
 
+/// The key nearest to the unknown `field` among those serde's `message` lists after "expected", where it is near
+/// enough to be a slip of the keyboard: at most a third of its letters (at least one) added, dropped, changed or
+/// swapped. The first of equally near keys, in the order serde lists them (the struct's).
+fn nearest_key(field: &str, message: &str) -> Option<String> {
+    let (_, expected) = message.split_once(", expected ")?;
+    expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|key| (strsim::damerau_levenshtein(field, key), key))
+        .filter(|&(d, key)| d <= (key.chars().count() / 3).max(1))
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, key)| key.to_string())
+}
+
 /// Make the key of a serde error the full dotted path of the offending field.
 fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
     let parent = if path == "." { String::new() } else { path.to_string() };
@@ -125,7 +140,11 @@ fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
             .map(str::to_string)
     };
     if let Some(field) = field_in("unknown field `") {
-        return (join(&field), "unknown key".to_string());
+        let key = join(&field);
+        let sibling = |near: String| format!("{}{near}", key.strip_suffix(field.as_str()).unwrap_or_default());
+        let hint =
+            nearest_key(&field, message).map_or(String::new(), |near| format!(" (did you mean {}?)", sibling(near)));
+        return (key, format!("unknown key{hint}"));
     }
     if let Some(field) = field_in("missing field `") {
         return (join(&field), "missing key".to_string());

@@ -48,6 +48,20 @@ fn defaults_and_overrides_by_index_name_and_single_item() {
 #[test]
 fn errors_name_file_and_key() {
     assert_eq!(err(SCENE, &["run.speed=3"]), "f.toml: run.speed: unknown key");
+    // A slip of the keyboard is answered with the key meant (at most a third of its letters wrong); a key far from
+    // every known one is not guessed at.
+    assert_eq!(
+        err(SCENE, &["run.end_tme=3"]),
+        "f.toml: run.end_tme: unknown key (did you mean run.end_time?)"
+    );
+    assert_eq!(
+        err(SCENE, &["solid[0].material.youngs_modlus=1e6"]),
+        "f.toml: solid[0].material.youngs_modlus: unknown key (did you mean solid[0].material.youngs_modulus?)"
+    );
+    assert_eq!(
+        err(&SCENE.replace("[run]", "[rnu]"), &[]),
+        "f.toml: rnu: unknown key (did you mean run?)"
+    );
     assert_eq!(
         err(&SCENE.replace("name = \"s\"\n", ""), &[]),
         "f.toml: run.name: missing key"
