@@ -69,7 +69,10 @@ pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 /// The file's text, at most [`MAX_SCENE_BYTES`] of it; `Err` says why not.
 fn read_bounded(path: &Path) -> Result<String, String> {
     use std::io::Read;
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read: {e}"))?;
+    let file = std::fs::File::open(path).map_err(|e| match nearest_file(path, &e) {
+        Some(near) => format!("cannot read: {e} (did you mean {}?)", near.display()),
+        None => format!("cannot read: {e}"),
+    })?;
     let mut bytes = Vec::new();
     file.take(MAX_SCENE_BYTES + 1)
         .read_to_end(&mut bytes)
@@ -78,6 +81,33 @@ fn read_bounded(path: &Path) -> Result<String, String> {
         return Err(format!("more than {} MiB: not a scene file", MAX_SCENE_BYTES >> 20));
     }
     String::from_utf8(bytes).map_err(|e| format!("cannot read: not UTF-8 text ({e})"))
+}
+
+/// Where `path` is not there, the file beside it whose name is nearest, as [`nearest_key`] judges a key.
+fn nearest_file(path: &Path, e: &std::io::Error) -> Option<std::path::PathBuf> {
+    if e.kind() != std::io::ErrorKind::NotFound {
+        return None;
+    }
+    let name = path.file_name()?.to_str()?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .ok()?
+        .flatten()
+        .filter(|f| f.file_type().is_ok_and(|t| t.is_file()))
+        .filter_map(|f| f.file_name().into_string().ok())
+        .collect();
+    // In name order: the same suggestion whatever order the directory lists them in.
+    names.sort();
+    let near = names
+        .iter()
+        .map(|n| (strsim::damerau_levenshtein(name, n), n))
+        .filter(|&(d, n)| d <= (n.chars().count() / 3).max(1))
+        .min_by_key(|&(d, _)| d)?
+        .1;
+    Some(path.with_file_name(near))
 }
 
 /// Parse, override and validate scene text; `file` names it in errors.

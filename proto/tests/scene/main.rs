@@ -76,6 +76,30 @@ fn errors_name_file_and_key() {
     assert!(err(SCENE, &["solid[0].element=hex8"]).starts_with("f.toml: solid[0].element: unknown variant `hex8`"));
 }
 
+/// A scene file that is not there, with a file beside it whose name is one slip away, names that file; a name far
+/// from every file there names none.
+#[test]
+fn a_missing_scene_file_names_the_one_beside_it_meant() {
+    let dir = std::env::temp_dir().join(format!("cosim-scene-near-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("elastic_gate.toml"), SCENE).unwrap();
+    std::fs::write(dir.join("dam_break.toml"), SCENE).unwrap();
+    let load = |name: &str| {
+        cosim_proto::scene::load(&dir.join(name), &[])
+            .err()
+            .map(|e| e.to_string())
+    };
+    let slip = load("elastic_gat.toml").expect("refused");
+    assert!(
+        slip.ends_with(&format!("(did you mean {}?)", dir.join("elastic_gate.toml").display())),
+        "{slip}"
+    );
+    let far = load("nothing_like_it.toml").expect("refused");
+    assert!(far.contains("cannot read") && !far.contains("did you mean"), "{far}");
+    assert!(load("dam_break.toml").is_none());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_column_probe_left_of_the_water_is_refused() {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dam_break.toml")).unwrap();
