@@ -184,5 +184,12 @@ fn key_of_serde_error(path: &str, message: &str) -> (String, String) {
     } else {
         parent
     };
+    // toml ends a value's error with the key again, as "in `solid.divisions`" (without the index) and a line break:
+    // the line names the key already.
+    let message = message.trim_end();
+    let message = match message.rfind("in `") {
+        Some(at) if message.ends_with('`') && message[..at].ends_with(char::is_whitespace) => message[..at].trim_end(),
+        _ => message,
+    };
     (key, message.replace('\n', " "))
 }

@@ -74,6 +74,11 @@ fn errors_name_file_and_key() {
     assert!(err(SCENE, &["novalue"]).contains("expected key.path=value"));
     assert!(err(&SCENE.replace("version = 1", "version = 2"), &[]).contains("version: this build reads version 1"));
     assert!(err(SCENE, &["solid[0].element=hex8"]).starts_with("f.toml: solid[0].element: unknown variant `hex8`"));
+    // toml's "in `solid.divisions`" and line break after a value's error are not repeated after the key.
+    assert_eq!(
+        err(SCENE, &["solid[0].divisions=[1]"]),
+        "f.toml: solid[0].divisions: invalid length 1, expected an array of length 2"
+    );
 }
 
 /// A scene file that is not there, with a file beside it whose name is one slip away, names that file; a name far
