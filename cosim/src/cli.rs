@@ -254,8 +254,8 @@ pub struct BenchRunArgs {
 /// `cosim inspect`.
 #[derive(Args, Debug, Clone)]
 pub struct InspectArgs {
-    /// Run id (printed by `cosim run`, and in `DIR/summary.json`).
-    pub id: String,
+    /// Run id (printed by `cosim run`, and in `DIR/summary.json`); without it, the runs on this machine are listed.
+    pub id: Option<String>,
     /// Print one JSON document with every process's status and exit.
     #[arg(long)]
     pub once: bool,

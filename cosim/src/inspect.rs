@@ -113,12 +113,12 @@ fn join_args(args: &InspectArgs, timeout: f64) -> crate::join::JoinArgs {
 }
 
 /// `cosim inspect ID --particle P | --node N`: one particle's or node's state as JSON (`look.rs`).
-fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+fn inspect_one(args: &InspectArgs, id: &str) -> anyhow::Result<ExitCode> {
     // A state is a checkpoint of every node: it may take longer than a status.
     let how = join_args(args, args.timeout.max(10.0));
-    let (session, connect) = crate::join::join(&args.id, &how)?;
+    let (session, connect) = crate::join::join(id, &how)?;
     let wait = cosim_bus::seconds::wait(how.timeout);
-    let fetch = |of| crate::look::fetch(&session, &args.id, wait, of);
+    let fetch = |of| crate::look::fetch(&session, id, wait, of);
     // A particle needs the fluid's state; the structure's only for its contact. Where the run's state cannot be had
     // whole (an outside program in the structure node's place saves no checkpoint), the fluid's alone is asked for.
     let (look, partial) = match fetch(StateOf::All) {
@@ -126,7 +126,7 @@ fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         Err(e) => match args.particle.is_some().then(|| fetch(StateOf::Fluid)) {
             Some(Ok(look)) => (look, Some(e)),
             _ => {
-                eprintln!("cosim: run `{}` at {connect}: {e:#}", args.id);
+                eprintln!("cosim: run `{id}` at {connect}: {e:#}");
                 return Ok(ExitCode::from(1));
             }
         },
@@ -147,25 +147,32 @@ fn inspect_one(args: &InspectArgs) -> anyhow::Result<ExitCode> {
 
 /// Run `cosim inspect`; `Err` for bad input (exit 2).
 pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    let Some(id) = args.id.as_deref() else {
+        anyhow::ensure!(
+            args.particle.is_none() && args.node.is_none(),
+            "--particle and --node need the run's id: `cosim inspect ID --particle P`"
+        );
+        return list(args.once);
+    };
     if args.particle.is_some() || args.node.is_some() {
-        return inspect_one(args);
+        return inspect_one(args, id);
     }
-    let (session, connect) = crate::join::join(&args.id, &join_args(args, args.timeout))?;
+    let (session, connect) = crate::join::join(id, &join_args(args, args.timeout))?;
     let timeout = cosim_bus::seconds::wait(args.timeout);
     if args.once {
-        let answers = query_all(&session, &args.id, timeout)?;
+        let answers = query_all(&session, id, timeout)?;
         if answers.is_empty() {
-            eprintln!("cosim: no process of run `{}` answered at {connect}", args.id);
+            eprintln!("cosim: no process of run `{id}` answered at {connect}");
             return Ok(ExitCode::from(1));
         }
-        println!("{:#}", document(&args.id, &answers));
+        println!("{:#}", document(id, &answers));
         return Ok(ExitCode::SUCCESS);
     }
     let terminal = std::io::stdout().is_terminal();
     let mut silent_since: Option<Instant> = None;
     loop {
-        let answers = query_all(&session, &args.id, timeout)?;
-        let doc = document(&args.id, &answers);
+        let answers = query_all(&session, id, timeout)?;
+        let doc = document(id, &answers);
         let mut out = std::io::stdout().lock();
         if terminal {
             let _ = write!(out, "\x1b[2J\x1b[H");
@@ -184,7 +191,7 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         if answers.is_empty() {
             let since = *silent_since.get_or_insert_with(Instant::now);
             if since.elapsed() > Duration::from_secs(3) {
-                eprintln!("cosim: run `{}` no longer answers (finished or gone)", args.id);
+                eprintln!("cosim: run `{id}` no longer answers (finished or gone)");
                 return Ok(ExitCode::SUCCESS);
             }
         } else {
@@ -192,4 +199,35 @@ pub fn inspect(args: &InspectArgs) -> anyhow::Result<ExitCode> {
         }
         std::thread::sleep(cosim_bus::seconds::wait(args.interval));
     }
+}
+
+/// `cosim inspect` without an id: the runs on this machine (`registry::live`), one line each, or with `--once` a JSON
+/// array of their entries. None running is not an error.
+fn list(json: bool) -> anyhow::Result<ExitCode> {
+    let runs = crate::registry::live();
+    if json {
+        println!("{:#}", serde_json::to_value(&runs)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    if runs.is_empty() {
+        println!(
+            "no run is going on this machine (none registered in {}; a run in one process cannot be inspected)",
+            crate::registry::dir().display()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut out = std::io::stdout().lock();
+    let width = runs.iter().map(|e| e.run.len()).max().unwrap_or(0).max(3);
+    let _ = writeln!(out, "{:width$}  {:>7}  {:24}  out", "run", "pid", "endpoint");
+    for e in &runs {
+        let _ = writeln!(
+            out,
+            "{:width$}  {:>7}  {:24}  {}",
+            e.run,
+            e.pid,
+            e.connect,
+            e.out.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -46,9 +46,9 @@ pub fn join(id: &str, how: &JoinArgs) -> anyhow::Result<(Session, String)> {
                 how.zenoh_config.clone().or(e.zenoh_config),
             ),
             None => anyhow::bail!(
-                "run `{id}` is not running on this machine (nothing in {}); give --connect ENDPOINT for a run \
-                 elsewhere (an in-process run cannot be reached from another process)",
-                registry::dir().display()
+                "run `{id}` is not running on this machine ({}); give --connect ENDPOINT for a run elsewhere (an \
+                 in-process run cannot be reached from another process)",
+                running_here()
             ),
         },
     };
@@ -98,6 +98,21 @@ fn refused(endpoint: &str) -> Option<String> {
                 .is_err_and(|e| e.kind() == std::io::ErrorKind::ConnectionRefused)
         });
     all_refused.then(|| address.to_string())
+}
+
+/// "running here: a, b" for the runs registered on this machine (`cosim inspect` lists them), or where none is.
+fn running_here() -> String {
+    let runs = registry::live();
+    if runs.is_empty() {
+        return format!("nothing in {}", registry::dir().display());
+    }
+    const SHOWN: usize = 5;
+    let ids: Vec<&str> = runs.iter().take(SHOWN).map(|e| e.run.as_str()).collect();
+    let more = match runs.len().saturating_sub(SHOWN) {
+        0 => String::new(),
+        n => format!(" and {n} more"),
+    };
+    format!("running here: {}{more}", ids.join(", "))
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! Where `cosim inspect ID` finds a run started on this machine: `cosim run` (processes mode) writes
 //! `$TMPDIR/cosim-runs/<ID>.json` with the endpoint to join once the broker listens, and removes it when the run
-//! ends. A run on another host is inspected with `--connect` instead.
+//! ends. A run on another host is inspected with `--connect` instead. `cosim inspect` without an id lists the runs
+//! registered here whose `cosim run` is alive.
 
 use std::path::{Path, PathBuf};
 
@@ -62,6 +63,27 @@ pub fn register(entry: &Entry) -> Option<Registration> {
 
 /// The entry of `run`, if one is registered and its `cosim run` is still alive.
 pub fn lookup(run: &str) -> Option<Entry> {
-    let entry: Entry = serde_json::from_slice(&std::fs::read(path(run)).ok()?).ok()?;
+    read(&path(run))
+}
+
+/// Every run registered here whose `cosim run` is alive, by run id. An entry left by a `cosim run` that was killed
+/// (it could not remove it) is not listed.
+pub fn live() -> Vec<Entry> {
+    let Ok(files) = std::fs::read_dir(dir()) else {
+        return Vec::new();
+    };
+    let mut runs: Vec<Entry> = files
+        .flatten()
+        .map(|f| f.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .filter_map(|p| read(&p))
+        .collect();
+    runs.sort_by(|a, b| a.run.cmp(&b.run));
+    runs
+}
+
+/// The entry in `file`, if it reads as one and its `cosim run` is still alive.
+fn read(file: &Path) -> Option<Entry> {
+    let entry: Entry = serde_json::from_slice(&std::fs::read(file).ok()?).ok()?;
     Path::new(&format!("/proc/{}", entry.pid)).exists().then_some(entry)
 }

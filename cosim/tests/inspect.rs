@@ -1,7 +1,8 @@
 //! Live inspection (`DESIGN.md` §5): while a coupled run goes on as three processes, `cosim inspect ID --once`
 //! from another process prints one JSON document with the status of the broker and both nodes (found through
 //! the local run registry, or with `--connect` to the run's endpoint as from another host); the refreshing table
-//! follows the run and ends when the run does; a run that is not going is refused.
+//! follows the run and ends when the run does; a run that is not going is refused; without an id, the runs going on
+//! this machine are listed.
 
 mod common;
 
@@ -104,6 +105,27 @@ fn inspect_a_running_coupled_run() {
     let (code, doc, text) = inspect(&[&id, "--once", "--connect", &endpoint]);
     assert_eq!(code, 0, "{text}");
     check_document(&doc, &id);
+    // Without an id: the runs on this machine (other tests' runs may be among them), this one with its endpoint,
+    // folder and the pid of its `cosim run`.
+    let (code, list, text) = inspect(&["--once"]);
+    assert_eq!(code, 0, "{text}");
+    let mine: Vec<&serde_json::Value> = list
+        .as_array()
+        .unwrap_or_else(|| panic!("{text}"))
+        .iter()
+        .filter(|e| e["run"] == id.as_str())
+        .collect();
+    assert_eq!(mine.len(), 1, "{text}");
+    assert_eq!(mine[0]["connect"], endpoint.as_str());
+    assert_eq!(mine[0]["out"], out.display().to_string());
+    assert_eq!(mine[0]["pid"].as_u64(), Some(u64::from(run.0.id())));
+    let (code, _, text) = inspect(&[]);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.lines().any(|l| l.starts_with(&format!("{id} "))), "{text}");
+    // A mistyped id is refused, saying what runs here.
+    let (code, _, text) = inspect(&[&format!("{id}x"), "--once"]);
+    assert_eq!(code, 2, "{text}");
+    assert!(text.contains("running here: "), "{text}");
     drop(run);
     // Gone: refused, naming the run.
     let (code, _, text) = inspect(&["no-such-run", "--once"]);
