@@ -51,6 +51,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let ratios = s.particle_to_cell_mass();
     let mut warnings = s.heavy_particle_warnings();
     warnings.extend(s.fluid_substeps_warning(dt_fluid));
+    warnings.extend(s.wall_impact_pressure_warning());
     if let (true, Some(d), Some(k)) = (coupled, dt_fem, substeps) {
         warnings.extend(s.long_coupling_step_warning(dt, d, k));
     }

@@ -127,7 +127,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         .as_ref()
         .and_then(|f| sph_node::time_step::at_rest(f, s.run.gravity));
     let substeps = s.fluid_substeps_warning(dt_fluid.unwrap_or(f64::INFINITY));
-    for w in s.heavy_particle_warnings().into_iter().chain(substeps) {
+    let impact = s.wall_impact_pressure_warning();
+    for w in s.heavy_particle_warnings().into_iter().chain(substeps).chain(impact) {
         eprintln!("cosim: warning: {w}");
     }
     let bar = Bar::new(args.quiet);

@@ -204,6 +204,44 @@ fn check_warns_of_an_isph_coupling_step_spanning_many_fe_steps() {
     assert!(warnings("scenes/hydrostatic_plate.toml", &[isph]).is_empty());
 }
 
+/// `cosim check` and `cosim run` warn where WCSPH's pressure probes sit on a wall's vertical face (what a wall impact
+/// reads there, docs/CORRECTIONS.md "WCSPH at the wall impact"): the Lobovsky scene's four sensor probes as
+/// shipped, none with the δ-SPH it recommends or with ISPH, and no other shipped scene (the dam break's floor probe
+/// is not on a side wall).
+#[test]
+fn check_and_run_warn_of_wcsph_pressure_probes_on_a_wall() {
+    let warnings = |scene: &str, extra: &[&str]| check_json(scene, extra)["warnings"].as_array().unwrap().clone();
+    let w = warnings("scenes/lobovsky_dam_break.toml", &[]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    let w = w[0].as_str().unwrap();
+    assert!(
+        w.starts_with("pressure probes p_sensor1, p_sensor2, p_sensor1_raw, p_sensor2_raw on a wall")
+            && w.contains("fluid.density_diffusion = 0.5"),
+        "{w}"
+    );
+    assert!(warnings("scenes/lobovsky_dam_break.toml", &["fluid.density_diffusion=0.5"]).is_empty());
+    assert!(warnings("scenes/lobovsky_dam_break.toml", &["fluid.solver=isph"]).is_empty());
+    assert!(warnings("scenes/dam_break.toml", &[]).is_empty());
+    // `cosim run` says it too, before it starts (a run of one millisecond).
+    let dir = scratch("check-impact-warning");
+    let out = cosim_run(
+        &[
+            "run",
+            &root().join("scenes/lobovsky_dam_break.toml").display().to_string(),
+            "--in-process",
+            "--quiet",
+            "--set",
+            "run.end_time=0.001",
+            "--out",
+            &dir.join("out").display().to_string(),
+        ],
+        Duration::from_secs(60),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("cosim: warning: pressure probes p_sensor1"), "{stderr}");
+}
+
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
 /// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]

@@ -7,12 +7,14 @@
 //! - `validate.rs`: the checks of every value a solver relies on;
 //! - `grid.rs`: the FEM grid numbering of a solid;
 //! - `sensors.rs`: the pressure sensors a fluid node samples every step (interval-mean pressure probes);
+//! - `impact.rs`: the warning for WCSPH pressure probes on a side wall (what an impact reads there);
 //! - [`sizing`]: counts and bytes of a run, estimated from the scene alone.
 //!
 //! Everything is re-exported here, so users name `cosim_proto::scene::Scene`, `cosim_proto::scene::parse`, ….
 
 pub mod disk;
 mod grid;
+mod impact;
 mod load;
 mod mass_ratio;
 mod overrides;
@@ -21,6 +23,7 @@ mod sensors;
 pub mod sizing;
 mod validate;
 
+pub use impact::IMPACT_DENSITY_DIFFUSION;
 pub use load::{load, parse, LoadedScene, SceneError};
 pub use schema::{
     whole_fluid_steps, Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter,
