@@ -30,6 +30,12 @@ proptest! {
     // No regression files: failures print their minimal input instead. A fixed seed: the same 64 scenes every run,
     // so that CI on a clean clone does not draw new ones each time (a fresh draw on 2026-11-27 found a deformable
     // scene whose velocity sweeps did not converge to 1e-14 within 2,000; noted for the contact work, not fixed).
+    // Another, found 2026-12-07 with the seed 0x1234_5678 at 2,000 cases (the 841st): a free vertex 2.5 times lighter
+    // than the particles pressed 2 Δx into its two segments is moved 0.14 m (5 Δx) by the position phase (masters
+    // moving, `move_masters`), onto a particle that was outside both segments' reach when the contacts were detected:
+    // it ends 0.047 m inside, approaching at 0.27 v_ref, and the velocity sweeps, which correct the detected contacts
+    // only, stop after 2. The algorithm detects once a pass (Long et al. 2016); the next pass would find it. The
+    // product's default holds the masters (`contact.move_structure = false`), where this cannot happen.
     #![proptest_config(ProptestConfig {
         cases: 64,
         failure_persistence: None,
