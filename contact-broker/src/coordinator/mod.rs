@@ -200,7 +200,7 @@ fn drive(
                     anyhow::anyhow!(
                         "stopped after coupling step {} (t = {} s): {why}",
                         clock.step,
-                        cosim_proto::Num(clock.t)
+                        cosim_proto::Num(cosim_proto::readable::significant(clock.t, 12))
                     )
                 })?;
             }

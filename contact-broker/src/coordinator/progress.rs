@@ -49,7 +49,7 @@ pub(super) fn report(
     if let Control::Break(why) = control {
         anyhow::bail!(
             "stopped after coupling step {step} (t = {} s): {why}",
-            cosim_proto::Num(t)
+            cosim_proto::Num(cosim_proto::readable::significant(t, 12))
         );
     }
     Ok(())
