@@ -216,15 +216,33 @@ fn list(json: bool) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    let mut out = std::io::stdout().lock();
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
     let width = runs.iter().map(|e| e.run.len()).max().unwrap_or(0).max(3);
-    let _ = writeln!(out, "{:width$}  {:>7}  {:24}  out", "run", "pid", "endpoint");
+    let scene_width = runs
+        .iter()
+        .filter_map(|e| e.scene.as_ref())
+        .map(String::len)
+        .max()
+        .unwrap_or(0)
+        .max(5);
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(
+        out,
+        "{:width$}  {:>7}  {:scene_width$}  {:>9}  {:24}  out",
+        "run", "pid", "scene", "running", "endpoint"
+    );
     for e in &runs {
+        let running = e
+            .since
+            .map_or("?".to_string(), |t| crate::progress::hms(now.saturating_sub(t) as f64));
         let _ = writeln!(
             out,
-            "{:width$}  {:>7}  {:24}  {}",
+            "{:width$}  {:>7}  {:scene_width$}  {running:>9}  {:24}  {}",
             e.run,
             e.pid,
+            e.scene.as_deref().unwrap_or("?"),
             e.connect,
             e.out.display()
         );

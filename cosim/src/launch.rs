@@ -296,6 +296,11 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         zenoh_config: args.zenoh_config.clone(),
         out: info.out.clone(),
         pid: std::process::id(),
+        scene: Some(scene.run.name.clone()),
+        since: std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .ok()
+            .map(|d| d.as_secs()),
     });
     if let Some(node) = args.external {
         let mode = if args.connect.is_some() { "client" } else { "peer" };

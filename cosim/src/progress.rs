@@ -94,7 +94,7 @@ pub fn plain_line(p: &Progress, elapsed: Duration) -> String {
 }
 
 /// Seconds as `1h02m03s`, `2m03s` or `3s`.
-fn hms(seconds: f64) -> String {
+pub fn hms(seconds: f64) -> String {
     let s = seconds.max(0.0).round() as u64;
     match (s / 3600, s / 60 % 60, s % 60) {
         (0, 0, s) => format!("{s}s"),

@@ -23,6 +23,12 @@ pub struct Entry {
     pub out: PathBuf,
     /// Process id of `cosim run`.
     pub pid: u32,
+    /// The scene's `run.name` (absent in an entry an older `cosim run` wrote).
+    #[serde(default)]
+    pub scene: Option<String>,
+    /// When the run registered, in seconds since the Unix epoch (absent as `scene`).
+    #[serde(default)]
+    pub since: Option<u64>,
 }
 
 /// The folder of the entries.

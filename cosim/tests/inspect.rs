@@ -119,6 +119,8 @@ fn inspect_a_running_coupled_run() {
     assert_eq!(mine[0]["connect"], endpoint.as_str());
     assert_eq!(mine[0]["out"], out.display().to_string());
     assert_eq!(mine[0]["pid"].as_u64(), Some(u64::from(run.0.id())));
+    assert_eq!(mine[0]["scene"], "elastic_gate");
+    assert!(mine[0]["since"].as_u64().is_some_and(|t| t > 1_700_000_000), "{text}");
     let (code, _, text) = inspect(&[]);
     assert_eq!(code, 0, "{text}");
     assert!(text.lines().any(|l| l.starts_with(&format!("{id} "))), "{text}");
