@@ -49,9 +49,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     // How many fluid steps a coupling step spans at most (`coupling.fluid_substeps`; WCSPH with particle_element).
     let fluid_span = s.fluid_steps_per_pass(dt_fluid);
     let ratios = s.particle_to_cell_mass();
-    let mut warnings = s.heavy_particle_warnings();
-    warnings.extend(s.fluid_substeps_warning(dt_fluid));
-    warnings.extend(s.wall_impact_pressure_warning());
+    let mut warnings = s.warnings(dt_fluid);
     if let (true, Some(d), Some(k)) = (coupled, dt_fem, substeps) {
         warnings.extend(s.long_coupling_step_warning(dt, d, k));
     }

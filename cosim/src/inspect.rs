@@ -216,9 +216,7 @@ fn list(json: bool) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
+    let now = crate::registry::now().unwrap_or(0);
     let width = runs.iter().map(|e| e.run.len()).max().unwrap_or(0).max(3);
     let scene_width = runs
         .iter()

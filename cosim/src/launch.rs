@@ -297,10 +297,7 @@ pub fn run_processes(args: &RunArgs, scene: &Scene, info: &RunInfo, bar: &Bar) -
         out: info.out.clone(),
         pid: std::process::id(),
         scene: Some(scene.run.name.clone()),
-        since: std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .ok()
-            .map(|d| d.as_secs()),
+        since: crate::registry::now(),
     });
     if let Some(node) = args.external {
         let mode = if args.connect.is_some() { "client" } else { "peer" };

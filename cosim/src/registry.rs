@@ -31,6 +31,14 @@ pub struct Entry {
     pub since: Option<u64>,
 }
 
+/// Seconds since the Unix epoch now (`Entry::since`); `None` with a clock set before it.
+pub fn now() -> Option<u64> {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .ok()
+        .map(|d| d.as_secs())
+}
+
 /// The folder of the entries.
 pub fn dir() -> PathBuf {
     std::env::temp_dir().join("cosim-runs")

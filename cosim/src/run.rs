@@ -126,9 +126,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         .fluid
         .as_ref()
         .and_then(|f| sph_node::time_step::at_rest(f, s.run.gravity));
-    let substeps = s.fluid_substeps_warning(dt_fluid.unwrap_or(f64::INFINITY));
-    let impact = s.wall_impact_pressure_warning();
-    for w in s.heavy_particle_warnings().into_iter().chain(substeps).chain(impact) {
+    for w in s.warnings(dt_fluid.unwrap_or(f64::INFINITY)) {
         eprintln!("cosim: warning: {w}");
     }
     let bar = Bar::new(args.quiet);

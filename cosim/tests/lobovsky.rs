@@ -100,13 +100,7 @@ fn assert_impulse_within(name: &str, b: &cosim::bench::lobovsky::SensorScore, to
     );
 }
 
-/// Runs the scene with the `--set`s `sets` and returns sensors 1 and 2, the water-level gauges H1–H4 (level/H) and
-/// the run's folder.
-fn h30_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch) {
-    lobovsky_run(name, sets)
-}
-
-/// [`h30_run`] at Δx = H/60: the sensor probes (and their `_raw` twins) half a spacing in front of the wall, x =
+/// [`lobovsky_run`] at Δx = H/60: the sensor probes (and their `_raw` twins) half a spacing in front of the wall, x =
 /// 1.6075 m, and frames at the start and the end only (every 10 ms would be 153 MB).
 fn h60_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch) {
     let mut all = vec![
@@ -121,6 +115,8 @@ fn h60_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch) {
     lobovsky_run(name, &all)
 }
 
+/// Runs the scene (Δx = H/30 as shipped) with the `--set`s `sets` and returns sensors 1 and 2, the water-level
+/// gauges H1–H4 (level/H) and the run's folder.
 fn lobovsky_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch) {
     let out = scratch(&format!("lobovsky-{name}"));
     let scene = root().join("scenes/lobovsky_dam_break.toml");
@@ -198,7 +194,7 @@ fn lobovsky_run(name: &str, sets: &[&str]) -> ([Sensor; 2], [Sensor; 4], Scratch
 /// jet thrown up the wall falling back through H4's line at t* 4.6–4.9).
 #[test]
 fn isph_h30_impact_time_peak_level_and_no_dropouts() {
-    let (sensors, gauges, out) = h30_run("isph-h30", &["fluid.solver=isph"]);
+    let (sensors, gauges, out) = lobovsky_run("isph-h30", &["fluid.solver=isph"]);
     assert_isph_bounds("H/30", &sensors, &gauges, &out);
 }
 
@@ -284,7 +280,7 @@ fn assert_isph_bounds(label: &str, sensors: &[Sensor; 2], gauges: &[Sensor; 4], 
 /// 1–3 ms where the recording takes tens), and the lowest sample, −4.7 / −5.3 ρgH (its rebound).
 #[test]
 fn wcsph_h30_with_delta_sph_impact_time_impulse_and_level_after() {
-    let (sensors, _, out) = h30_run("wcsph-h30", &["fluid.density_diffusion=0.5"]);
+    let (sensors, _, out) = lobovsky_run("wcsph-h30", &["fluid.density_diffusion=0.5"]);
     let bench = cosim::bench::lobovsky::score(&out, &root().join("scenes")).expect("bench score");
     for (s, b) in sensors.iter().zip(&bench) {
         let (sim, exp) = s.first();

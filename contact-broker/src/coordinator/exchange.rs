@@ -96,15 +96,11 @@ impl Expected {
 /// The box the run starts in: the scene's walls, fluid blocks and solids, and the points the nodes registered (the
 /// structure's nodes `mesh`, the wall particles `walls`); the whole plane where there are none.
 fn start(scene: &Scene, mesh: &[[f64; 2]], walls: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
-    let boxes = (scene.walls.iter().chain(scene.fluid.iter().flat_map(|f| &f.blocks)))
-        .map(|b| (b.min, b.max))
-        .chain(scene.solids.iter().map(|s| (s.min, s.max)))
-        .chain(mesh.iter().chain(walls).map(|&p| (p, p)));
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for (a, b) in boxes {
+    let (mut lo, mut hi) = scene.bounds();
+    for p in mesh.iter().chain(walls) {
         for k in 0..2 {
-            lo[k] = lo[k].min(a[k]);
-            hi[k] = hi[k].max(b[k]);
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
         }
     }
     if lo[0] <= hi[0] {

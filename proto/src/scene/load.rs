@@ -83,7 +83,7 @@ fn read_bounded(path: &Path) -> Result<String, String> {
     String::from_utf8(bytes).map_err(|e| format!("cannot read: not UTF-8 text ({e})"))
 }
 
-/// Where `path` is not there, the file beside it whose name is nearest, as [`nearest_key`] judges a key.
+/// Where `path` is not there, the file beside it whose name is [`nearest`] to its name.
 fn nearest_file(path: &Path, e: &std::io::Error) -> Option<std::path::PathBuf> {
     if e.kind() != std::io::ErrorKind::NotFound {
         return None;
@@ -101,13 +101,19 @@ fn nearest_file(path: &Path, e: &std::io::Error) -> Option<std::path::PathBuf> {
         .collect();
     // In name order: the same suggestion whatever order the directory lists them in.
     names.sort();
-    let near = names
-        .iter()
-        .map(|n| (strsim::damerau_levenshtein(name, n), n))
-        .filter(|&(d, n)| d <= (n.chars().count() / 3).max(1))
-        .min_by_key(|&(d, _)| d)?
-        .1;
-    Some(path.with_file_name(near))
+    nearest(name, names.iter().map(String::as_str)).map(|near| path.with_file_name(near))
+}
+
+/// Of `candidates`, the one nearest to `name` where it is near enough to be a slip of the keyboard: at most a third
+/// of its letters (at least one) added, dropped, changed or swapped (Damerau–Levenshtein). The first of equally near
+/// ones.
+fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .into_iter()
+        .map(|c| (strsim::damerau_levenshtein(name, c), c))
+        .filter(|&(d, c)| d <= (c.chars().count() / 3).max(1))
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, c)| c)
 }
 
 /// Parse, override and validate scene text; `file` names it in errors.
@@ -135,19 +141,11 @@ fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> SceneError {
     SceneError::new(file, key, e.message().replace('\n', " "))
 }
 
-/// The key nearest to the unknown `field` among those serde's `message` lists after "expected", where it is near
-/// enough to be a slip of the keyboard: at most a third of its letters (at least one) added, dropped, changed or
-/// swapped. The first of equally near keys, in the order serde lists them (the struct's).
+/// The key [`nearest`] to the unknown `field` among those serde's `message` lists after "expected", in the order
+/// serde lists them (the struct's).
 fn nearest_key(field: &str, message: &str) -> Option<String> {
     let (_, expected) = message.split_once(", expected ")?;
-    expected
-        .split('`')
-        .skip(1)
-        .step_by(2)
-        .map(|key| (strsim::damerau_levenshtein(field, key), key))
-        .filter(|&(d, key)| d <= (key.chars().count() / 3).max(1))
-        .min_by_key(|&(d, _)| d)
-        .map(|(_, key)| key.to_string())
+    nearest(field, expected.split('`').skip(1).step_by(2)).map(str::to_string)
 }
 
 /// Make the key of a serde error the full dotted path of the offending field.

@@ -8,6 +8,7 @@
 //! - `grid.rs`: the FEM grid numbering of a solid;
 //! - `sensors.rs`: the pressure sensors a fluid node samples every step (interval-mean pressure probes);
 //! - `impact.rs`: the warning for WCSPH pressure probes on a side wall (what an impact reads there);
+//! - `warnings.rs`: the warnings `cosim check` and `cosim run` both give;
 //! - [`sizing`]: counts and bytes of a run, estimated from the scene alone.
 //!
 //! Everything is re-exported here, so users name `cosim_proto::scene::Scene`, `cosim_proto::scene::parse`, ….
@@ -22,6 +23,7 @@ mod schema;
 mod sensors;
 pub mod sizing;
 mod validate;
+mod warnings;
 
 pub use impact::IMPACT_DENSITY_DIFFUSION;
 pub use load::{load, parse, LoadedScene, SceneError};

@@ -119,6 +119,22 @@ impl BoxSpec {
 }
 
 impl Scene {
+    /// The box round the fluid's blocks, the walls and the solids (lower, upper corner); inverted (lower +∞, upper
+    /// −∞) where the scene has none of them.
+    pub fn bounds(&self) -> ([f64; 2], [f64; 2]) {
+        let boxes = (self.fluid.iter().flat_map(|f| &f.blocks).chain(&self.walls))
+            .map(|b| (b.min, b.max))
+            .chain(self.solids.iter().map(|s| (s.min, s.max)));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for (min, max) in boxes {
+            for k in 0..2 {
+                lo[k] = lo[k].min(min[k]);
+                hi[k] = hi[k].max(max[k]);
+            }
+        }
+        (lo, hi)
+    }
+
     /// The scene as TOML text (used to hand the resolved scene to the nodes).
     pub fn to_toml(&self) -> String {
         toml::to_string(self).expect("a validated scene serialises")

@@ -196,17 +196,7 @@ pub(super) fn validate_probes(scene: &Scene, solids: &HashSet<&str>) -> Result<(
 /// The box around the fluid's blocks, the walls and the solids, padded on every side by its larger size: where
 /// the water can go (the fluid node's domain pads by half that, `sph_node::setup`).
 fn extent(scene: &Scene) -> [[f64; 2]; 2] {
-    let boxes = scene.fluid.iter().flat_map(|f| f.blocks.iter().map(|b| (b.min, b.max)));
-    let boxes = boxes
-        .chain(scene.walls.iter().map(|w| (w.min, w.max)))
-        .chain(scene.solids.iter().map(|s| (s.min, s.max)));
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for (min, max) in boxes {
-        for k in 0..2 {
-            lo[k] = lo[k].min(min[k]);
-            hi[k] = hi[k].max(max[k]);
-        }
-    }
+    let (lo, hi) = scene.bounds();
     let pad = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     [[lo[0] - pad, lo[1] - pad], [hi[0] + pad, hi[1] + pad]]
 }
