@@ -21,6 +21,7 @@ mod position;
 mod projection;
 mod report;
 mod rigid;
+mod segment_grid;
 mod setup;
 mod touching;
 mod velocity;
@@ -96,9 +97,9 @@ pub fn particle_element_with(
     marks.resize(particles.x.len(), Mark::default());
     memo.clear();
 
-    let setup = Setup::new(grid, topo, inv_m, statics, &nodes, segments, params, *exhaustive);
+    let mut setup = Setup::new(grid, topo, inv_m, statics, &nodes, segments, params, *exhaustive);
     position::phase(
-        &setup,
+        &mut setup,
         &mut particles,
         &mut nodes,
         masters,

@@ -14,6 +14,9 @@ use crate::contact::bodies::{Nodes, Particles};
 use crate::contact::geometry::{axpy, Vec2};
 
 /// Runs the position sweeps until a sweep's deepest penetration is within `tol_x` or `params.sweeps` are done.
+/// Where the masters move, a sweep after which a node had left the reach its segment grid allows for rebuilds the
+/// grid and is followed by another sweep, within the same count (`segment_grid.rs`): the particles that node
+/// moved onto were not gathered in it.
 /// `masters` and `rigid` are scratch: the masters near the particle being visited, and the immovable ones of them;
 /// `gaps` and `memo` too (their gaps, [`Gaps`], and those kept per particle, [`Memo`]).
 ///
@@ -24,7 +27,7 @@ use crate::contact::geometry::{axpy, Vec2};
 /// the same nothing (bit-identical result).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn phase(
-    setup: &Setup,
+    setup: &mut Setup,
     particles: &mut Particles,
     nodes: &mut Nodes,
     masters: &mut Vec<Master>,
@@ -35,7 +38,6 @@ pub(super) fn phase(
     out: Out,
 ) {
     let Out { report, pairs } = out;
-    let pos_fixed = &*setup.pos_fixed;
     for sweep in 0..setup.params.sweeps {
         let first = sweep == 0;
         let mut worst = 0.0f64;
@@ -59,7 +61,7 @@ pub(super) fn phase(
             rigid.clear();
             let im_s = 1.0 / particles.m[s];
             for &m in masters.iter() {
-                if setup.detector(nodes.x).is_rigid(m, pos_fixed) {
+                if setup.detector(nodes.x).is_rigid(m, &setup.pos_fixed) {
                     rigid.push(m);
                     continue;
                 }
@@ -121,7 +123,8 @@ pub(super) fn phase(
             }
         }
         report.position_sweeps += 1;
-        if worst <= setup.tol_x {
+        let regridded = setup.regrid_if_stale(nodes.x);
+        if worst <= setup.tol_x && !regridded {
             break;
         }
     }

@@ -6,9 +6,9 @@ use std::borrow::Cow;
 
 use super::detection::{Detector, Master, Topology};
 use super::params::ContactParams;
+use super::segment_grid::SegmentGrid;
 use crate::contact::bodies::{Nodes, Segment};
-use crate::contact::geometry::{sub, Frame, Vec2};
-use crate::contact::grid::CellGrid;
+use crate::contact::geometry::{Frame, Vec2};
 
 /// What the pass knows about one particle: whether it was corrected, and what its position-phase visits learnt,
 /// for the skips that hold while the nodes are static.
@@ -42,7 +42,7 @@ pub(super) struct Setup<'a> {
     pub params: ContactParams,
     pub segments: &'a [Segment],
     topo: &'a Topology,
-    grid: &'a CellGrid,
+    grid: &'a mut SegmentGrid,
     /// 1/m per node, 0 for a fixed node.
     pub inv_m: &'a [f64],
     /// The fixed nodes (infinite mass).
@@ -74,7 +74,7 @@ impl<'a> Setup<'a> {
     /// `segments` is not empty.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
-        grid: &'a mut CellGrid,
+        grid: &'a mut SegmentGrid,
         topo: &'a mut Topology,
         inv_m: &'a mut Vec<f64>,
         statics: &'a mut StaticGeometry,
@@ -93,16 +93,8 @@ impl<'a> Setup<'a> {
         // candidate list also covers the places an exact rigid projection may move it to.
         let (r_c, d_max) = (params.thickness, params.far_side);
         let inflate = 2.0 * r_c.max(d_max);
-        let mean_len = segments.iter().map(|s| dist(nodes.x[s.a], nodes.x[s.b])).sum::<f64>() / segments.len() as f64;
-        {
-            let x = &*nodes.x;
-            grid.build(segments.len(), inflate.max(mean_len), |j| {
-                let (a, b) = (x[segments[j].a], x[segments[j].b]);
-                let lo = [a[0].min(b[0]) - inflate, a[1].min(b[1]) - inflate];
-                let hi = [a[0].max(b[0]) + inflate, a[1].max(b[1]) + inflate];
-                (lo, hi)
-            });
-        }
+        // Tracked where the masters may move in the position phase (`segment_grid.rs`).
+        grid.build(nodes.x, segments, inflate, params.move_masters);
         let coord = nodes.x.iter().fold(0.0f64, |c, x| c.max(x[0].abs()).max(x[1].abs()));
         // Convergence tolerance, and the round-off allowance of the exact rigid projection (16 ulp of the
         // coordinates).
@@ -138,7 +130,7 @@ impl<'a> Setup<'a> {
             statics.node_acts.clear();
             statics.node_acts.extend((0..nn).map(|k| det.node_may_act(k)));
             statics.boxes.clear();
-            statics.boxes.extend(grid.items().iter().map(|&j| {
+            statics.boxes.extend(grid.cells.items().iter().map(|&j| {
                 let s = segments[j as usize];
                 let (a, b) = (nodes.x[s.a], nodes.x[s.b]);
                 [a[0].min(b[0]), a[0].max(b[0]), a[1].min(b[1]), a[1].max(b[1])]
@@ -162,6 +154,16 @@ impl<'a> Setup<'a> {
             min_len,
             statics,
         }
+    }
+
+    /// Bins the segments again at node positions `x` when the masters have moved more than the grid allows for
+    /// ([`SegmentGrid::stale`]); whether it did. Never with static nodes (nothing moves).
+    pub fn regrid_if_stale(&mut self, x: &[Vec2]) -> bool {
+        if self.nodes_static || !self.grid.stale(x) {
+            return false;
+        }
+        self.grid.rebuild(x, self.segments);
+        true
     }
 
     /// The detector at node positions `x`.
@@ -198,8 +200,8 @@ impl<'a> Setup<'a> {
         if let Some(g) = self.statics {
             // Static nodes: the boxes of the grid's build, read in the cell's order; the same comparisons of the
             // same numbers as below, so the same masters.
-            let range = self.grid.query_range(xs);
-            let (items, boxes) = (&self.grid.items()[range.clone()], &g.boxes[range]);
+            let range = self.grid.cells.query_range(xs);
+            let (items, boxes) = (&self.grid.cells.items()[range.clone()], &g.boxes[range]);
             for (&j, bx) in items.iter().zip(boxes) {
                 let outside = xs[0] < bx[0] - inflate
                     || xs[0] > bx[1] + inflate
@@ -214,7 +216,7 @@ impl<'a> Setup<'a> {
             }
             return;
         }
-        for &j in self.grid.query(xs) {
+        for &j in self.grid.cells.query(xs) {
             let s = self.segments[j as usize];
             let (a, b) = (x[s.a], x[s.b]);
             let outside = |k: usize| xs[k] < a[k].min(b[k]) - inflate || xs[k] > a[k].max(b[k]) + inflate;
@@ -223,11 +225,4 @@ impl<'a> Setup<'a> {
             }
         }
     }
-}
-
-/// |a − b| (`hypot`: the mean segment length that sizes the grid).
-#[inline]
-pub(super) fn dist(a: Vec2, b: Vec2) -> f64 {
-    let d = sub(a, b);
-    d[0].hypot(d[1])
 }

@@ -1,6 +1,6 @@
 //! Unit tests of the particle–element pass: the formulas on one contact, bad input, and the static-node skips.
 
-use super::setup::dist;
+use super::segment_grid::dist;
 use super::*;
 use crate::contact::geometry::{axpy, cross, sub, Vec2};
 

@@ -5,9 +5,9 @@ use super::memo::Memo;
 use super::pairs::{ContactPair, PairLog};
 use super::projection::Planes;
 use super::rigid::Gaps;
+use super::segment_grid::SegmentGrid;
 use super::setup::{Mark, StaticGeometry};
 use super::touching::Contact;
-use crate::contact::grid::CellGrid;
 
 /// Scratch arrays of [`particle_element_with`](super::particle_element_with): keep one per caller and pass it to
 /// every call so the arrays are allocated once. Holds no state between calls: results never depend on what it held
@@ -15,7 +15,7 @@ use crate::contact::grid::CellGrid;
 #[derive(Clone, Debug, Default)]
 pub struct ParticleElementWorkspace {
     /// The segments binned in cells (set-up).
-    pub(super) grid: CellGrid,
+    pub(super) grid: SegmentGrid,
     /// Node → segment tables (set-up).
     pub(super) topo: Topology,
     /// 1/m per node, 0 for a fixed one (set-up).
