@@ -242,6 +242,30 @@ fn check_and_run_warn_of_wcsph_pressure_probes_on_a_wall() {
     assert!(stderr.contains("cosim: warning: pressure probes p_sensor1"), "{stderr}");
 }
 
+/// A solid with no `fixed` box is warned of (the walls act on the fluid only: gravity takes it through the floor;
+/// `proto/src/scene/unheld.rs`); every shipped solid is held.
+#[test]
+fn check_warns_of_a_solid_held_nowhere() {
+    let warnings = |scene: &str, extra: &[&str]| check_json(scene, extra)["warnings"].as_array().unwrap().clone();
+    for scene in [
+        "scenes/elastic_gate.toml",
+        "scenes/elastic_obstacle.toml",
+        "scenes/hydrostatic_plate.toml",
+    ] {
+        assert!(warnings(scene, &[]).is_empty(), "{scene}");
+    }
+    let w = warnings(
+        "scenes/elastic_gate.toml",
+        &["solid[0].fixed=[]", "solid[0].material.density=2700.0"],
+    );
+    assert_eq!(w.len(), 1, "{w:?}");
+    let w = w[0].as_str().unwrap();
+    assert!(
+        w.starts_with("solid `gate` is held nowhere (no `fixed` box)") && w.ends_with("it sinks"),
+        "{w}"
+    );
+}
+
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the
 /// paper's Shepard filter, XSPH and APD β = 0.04; ISPH XSPH and APD β = 0.04, no density filter.
 #[test]
