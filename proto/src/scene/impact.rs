@@ -64,13 +64,8 @@ impl Scene {
 
 #[cfg(test)]
 mod tests {
-    use crate::scene::parse;
-
     fn scene(sets: &[&str]) -> crate::scene::Scene {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/lobovsky_dam_break.toml");
-        let text = std::fs::read_to_string(path).unwrap();
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        parse("lobovsky_dam_break.toml", &text, &sets).unwrap()
+        crate::scene::shipped("lobovsky_dam_break.toml", sets)
     }
 
     #[test]

@@ -37,3 +37,14 @@ pub use schema::{
     STRUCTURE_COURANT_MIN, SUBSTEP_SLACK, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use sensors::{face_mean as sensors_face_mean, PressureSensor};
+
+/// The shipped scene `scenes/NAME` with `--set` overrides `sets` (unit tests of what a scene warns of).
+#[cfg(test)]
+pub(crate) fn shipped(name: &str, sets: &[&str]) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes")
+        .join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    parse(name, &text, &sets).unwrap()
+}

@@ -45,13 +45,8 @@ impl Scene {
 
 #[cfg(test)]
 mod tests {
-    use crate::scene::parse;
-
     fn gate(sets: &[&str]) -> crate::scene::Scene {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/elastic_gate.toml");
-        let text = std::fs::read_to_string(path).unwrap();
-        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        parse("elastic_gate.toml", &text, &sets).unwrap()
+        crate::scene::shipped("elastic_gate.toml", sets)
     }
 
     #[test]
