@@ -7,7 +7,7 @@ panicked or hung (exit not 0, 1 or 2), the last line it said; and the overrides 
 
 --held keeps a clamp on every solid (a solid held nowhere falls through the walls: unheld.rs warns of it). The
 session's sweep: seed 3 (30 scenes) and seed 4 --held (40) of this script, and 30 of an earlier variant (2-10 ms
-runs, the solid anywhere from x = 0.1 to 0.35 m)."""
+runs at 4-8 mm, the solid anywhere with x0 from -0.05 to 0.3 m)."""
 import random, subprocess, sys, os, tempfile, concurrent.futures as cf
 seed=int(sys.argv[1]); n=int(sys.argv[2]); held="--held" in sys.argv
 ROOT=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
