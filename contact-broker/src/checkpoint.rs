@@ -39,8 +39,9 @@ pub use broker_state::BrokerState;
 /// structure (`BrokerState::owed`); 5: the contact's bound on the coupling step (`BrokerState::dt_contact`); 6: the
 /// run's energy balance (`Summary::energy_growth`); 7: the structure's bound on the coupling step
 /// (`BrokerState::dt_structure`); 8: the positions a WCSPH fluid's Verlet candidates were gathered at (in `sph.bin`);
-/// 9: the energy balance's rounding (`EnergyGrowth::rounding`).
-pub const FORMAT: u32 = 9;
+/// 9: the energy balance's rounding (`EnergyGrowth::rounding`); 10: the first structure node found inside a wall
+/// (`Summary::solid_in_wall`).
+pub const FORMAT: u32 = 10;
 /// The manifest's file name.
 pub const MANIFEST: &str = "checkpoint.json";
 const TAG: &str = "cosim-broker-checkpoint";

@@ -23,3 +23,4 @@ pub mod setup;
 pub mod step_budget;
 pub mod summary;
 pub mod transport;
+pub mod wall_entry;

@@ -264,6 +264,58 @@ fn check_warns_of_a_solid_held_nowhere() {
         w.starts_with("solid `gate` is held nowhere (no `fixed` box)") && w.ends_with("it sinks"),
         "{w}"
     );
+    // Run, such a solid is watched (`contact_broker::wall_entry`): a block dropped 5 mm above the floor, clear of the
+    // water, is 9.93 mm lower at t = 0.045 s (g t²/2), 4.93 mm into the floor, past half a spacing (3 mm); not at
+    // 0.04 s (7.85 mm fallen, 2.85 mm in). The run still ends `ok`, and says it.
+    let dir = scratch("check-solid-in-wall");
+    let out_dir = dir.join("out");
+    let out = cosim_run(
+        &[
+            "run",
+            &root().join("scenes/elastic_gate.toml").display().to_string(),
+            "--in-process",
+            "--quiet",
+            "--set",
+            "fluid.spacing=0.006",
+            "--set",
+            "run.end_time=0.06",
+            "--set",
+            "solid[0].min=[0.3,0.005]",
+            "--set",
+            "solid[0].max=[0.35,0.03]",
+            "--set",
+            "solid[0].divisions=[5,3]",
+            "--set",
+            "solid[0].fixed=[]",
+            "--set",
+            "probe[0].point=[0.325,0.005]",
+            "--set",
+            "probe[1].point=[0.325,0.005]",
+            "--out",
+            &out_dir.display().to_string(),
+        ],
+        Duration::from_secs(60),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("cosim: warning: at t = 0.045 s node 0 of solid `gate` was 4.933e-3 m inside wall[0]"),
+        "{stderr}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    let e = &summary["solid_in_wall"];
+    assert_eq!(
+        (e["t"].as_f64(), e["node"].as_u64(), e["wall"].as_u64()),
+        (Some(0.045), Some(0), Some(0)),
+        "{e}"
+    );
+    // g t²/2 − 5 mm, to round-off of the structure's explicit steps
+    let depth = 0.5 * 9.81 * 0.045f64.powi(2) - 0.005;
+    assert!(
+        (e["depth"].as_f64().unwrap() - depth).abs() < 1e-6,
+        "{e} against {depth}"
+    );
 }
 
 /// `cosim check` says which corrections a fluid runs with (§4.4), the per-solver defaults filled in: WCSPH the

@@ -141,6 +141,25 @@ impl BrokerState {
                 s.fem_nodes
             )
         })?;
+        if let Some(e) = &s.solid_in_wall {
+            // Only ever read back into the summary and the run's last message, but checked as every other field.
+            ensure(
+                e.t.is_finite()
+                    && (0.0..=self.t).contains(&e.t)
+                    && e.depth.is_finite()
+                    && e.depth > 0.0
+                    && u64::from(e.node) < fem_nodes
+                    && e.wall < scene.walls.len(),
+                || {
+                    format!(
+                        "summary.solid_in_wall = {e:?} is not a node inside a wall (t within 0..{}, depth > 0, node \
+                         below {fem_nodes}, wall below {})",
+                        self.t,
+                        scene.walls.len()
+                    )
+                },
+            )?;
+        }
         let particles = match scene.fluid {
             Some(_) => s.particles,
             None => 0,
@@ -340,6 +359,7 @@ component = "x"
                 contact_step_bound: None,
                 energy_growth: None,
                 trace: None,
+                solid_in_wall: None,
             },
         }
     }
@@ -381,6 +401,29 @@ component = "x"
         assert_eq!(e, "summary.fem_nodes = 9 where the scene's solids have 6 nodes");
         let e = refused(|s| s.rows.push((0.25, vec![0.5])));
         assert_eq!(e, "summary.samples = 3 and summary.frames = 3 where rows holds 4");
+        let entry = |t: f64, node: u32, wall: usize, depth: f64| crate::wall_entry::WallEntry {
+            t,
+            solid: "gate".into(),
+            node,
+            wall,
+            depth,
+        };
+        let mut fine = state();
+        fine.summary.solid_in_wall = Some(entry(0.25, 5, 0, 1e-3));
+        fine.check(&scene()).unwrap();
+        for bad in [
+            entry(0.3, 5, 0, 1e-3),
+            entry(0.25, 6, 0, 1e-3),
+            entry(0.25, 5, 1, 1e-3),
+            entry(0.25, 5, 0, 0.0),
+            entry(f64::NAN, 5, 0, 1e-3),
+        ] {
+            let e = refused(|s| s.summary.solid_in_wall = Some(bad.clone()));
+            assert!(
+                e.starts_with("summary.solid_in_wall = ") && e.ends_with("node below 6, wall below 1)"),
+                "{e}"
+            );
+        }
         let e = state().check_nodes(6, 17).unwrap_err().to_string();
         assert!(e.contains("16 fluid particles") && e.contains("have 6 and 17"), "{e}");
     }

@@ -19,6 +19,7 @@ use crate::energy_balance::{elastic_energy, elastic_eos, elastic_size, releasabl
 use crate::output::{plot_probe, FrameQueue, FrameWriter, Part, PointField, ProbeCsv};
 use crate::probes::{LoadLog, Probes};
 use crate::summary::Summary;
+use crate::wall_entry::WallWatch;
 
 /// Probe values over time, per probe.
 pub(super) type Series = Vec<Vec<(f64, f64)>>;
@@ -37,6 +38,8 @@ pub(super) struct Outputs<'s> {
     density: f64,
     /// The WCSPH fluid's equation of state, for its elastic energy in the energy balance (`None`: ISPH, no fluid).
     eos: Option<Tait>,
+    /// The structure's nodes watched against the walls (`None` without walls, fluid or structure).
+    wall_watch: Option<WallWatch>,
 }
 
 impl<'s> Outputs<'s> {
@@ -66,6 +69,7 @@ impl<'s> Outputs<'s> {
         let density = nodes.sph.as_ref().map_or(0.0, |n| n.setup().density);
         let csv = ProbeCsv::create(&out.join("probes.csv"), probes.names())?;
         let eos = elastic_eos(&scene.scene);
+        let wall_watch = mesh.as_deref().and_then(|m| WallWatch::new(&scene.scene, m));
         Ok(Self {
             probes,
             csv,
@@ -76,6 +80,7 @@ impl<'s> Outputs<'s> {
             walls,
             density,
             eos,
+            wall_watch,
         })
     }
 
@@ -118,6 +123,20 @@ impl<'s> Outputs<'s> {
         self.push_series(t, &values);
         let index = summary.samples as usize;
         energy_balance(&self.probes, self.eos.as_ref(), t, index, fem, sph, summary);
+        if let (Some(watch), Some((mesh, snap)), None) = (&self.wall_watch, fem, &summary.solid_in_wall) {
+            summary.solid_in_wall = watch.observe(t, &snap.x, mesh).inspect(|e| {
+                tracing::warn!(
+                    "at t = {} s node {} of solid `{}` is {:.3e} m inside wall[{}]: the walls hold the fluid, not the \
+                     structure, so it passes through them and what follows is not the tank's physics (summary.json \
+                     solid_in_wall)",
+                    Num(e.t),
+                    e.node,
+                    e.solid,
+                    e.depth,
+                    e.wall
+                )
+            });
+        }
         summary.samples += 1;
         if self.run.is_frame(index as u64, last) {
             if let (Some(mesh), Some(snap)) = (&self.mesh, round.fem.as_mut().and_then(|s| s.snapshot.take())) {

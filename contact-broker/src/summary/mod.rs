@@ -106,6 +106,10 @@ pub struct Summary {
     /// `--record`: what the trace holds, and why it stopped before the run's end if it did; `null` without it.
     #[serde(default)]
     pub trace: Option<TraceNote>,
+    /// The first structure node found inside a wall at an output time (`wall_entry.rs`: the walls hold the fluid,
+    /// not the structure); `null` where none was.
+    #[serde(default)]
+    pub solid_in_wall: Option<crate::wall_entry::WallEntry>,
 }
 
 /// What `--record` wrote (`crate::recorder`).
@@ -143,6 +147,7 @@ impl Summary {
         self.timings = saved.timings.clone();
         self.contact_stats = saved.contact_stats.clone();
         self.energy_growth = saved.energy_growth.clone();
+        self.solid_in_wall = saved.solid_in_wall.clone();
     }
 
     /// End the run after `wall_seconds`: `ok`, saying how far it got, or `failure`'s status and message.
@@ -198,6 +203,7 @@ impl SummaryBuilder {
             contact_step_bound: None,
             energy_growth: None,
             trace: None,
+            solid_in_wall: None,
         })
     }
 
