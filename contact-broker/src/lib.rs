@@ -23,4 +23,5 @@ pub mod setup;
 pub mod step_budget;
 pub mod summary;
 pub mod transport;
+pub mod wall_contact;
 pub mod wall_entry;

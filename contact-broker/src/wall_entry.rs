@@ -1,12 +1,14 @@
-//! A structure gone into a tank wall (`summary.json` `solid_in_wall`).
+//! A structure gone into a tank wall (`summary.json` `solid_in_wall`): the net under the walls' contact.
 //!
-//! The walls (`[[wall]]`) are the fluid's boundary particles; the structure node knows nothing of them, so a solid
-//! that reaches one passes through it, and the water caught between the two is squeezed without bound (a free block
-//! dropped onto the floor drove the fluid to 1.8 times the energy the water can release; docs/VALIDATION.md,
-//! 2026-12-07 thirty-third). `cosim check` warns of a solid held nowhere (`cosim_proto::scene` `unheld.rs`); a held
-//! one can still bend into a wall. So the broker looks at the structure's nodes at every output time and notes the
-//! first one found inside a wall, by more than half a fluid spacing, that was not within that distance of a wall
-//! where the scene put it (a clamped end may start on a wall's face or in it).
+//! The walls (`[[wall]]`) are the fluid's boundary particles; the structure node knows nothing of them. The broker
+//! puts the structure's surface nodes back on a wall's surface after each contact pass (`wall_contact.rs`), so a node
+//! ends a step inside a wall by at most its displacement over that step. One found deeper has gone past that
+//! contact: a node off the surface, or one fast enough to cross half a spacing in a step (before `wall_contact.rs`,
+//! every solid that reached a wall went through it: a free block dropped onto the floor drove the water to 1.8
+//! times the energy it can release; docs/VALIDATION.md, 2026-12-07 thirty-third). So the broker looks at the
+//! structure's nodes at every output time and notes the first one found inside a wall by more than half a fluid
+//! spacing that was not within that distance of a wall where the scene put it (a clamped end may start on a wall's
+//! face or in it).
 
 use cosim_proto::messages::FemMesh;
 use cosim_proto::scene::Scene;

@@ -167,12 +167,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
         if let Some(why) = summary.trace.as_ref().and_then(|t| t.stopped.as_ref()) {
             eprintln!("cosim: warning: the trace holds the run only in part: the recording stopped {why}");
         }
-        // A structure inside a wall (`contact_broker::wall_entry`): the walls hold the fluid only.
+        // A structure node past the walls' contact (`contact_broker::wall_entry`).
         if let Some(e) = summary.solid_in_wall.as_ref() {
             eprintln!(
-                "cosim: warning: at t = {} s node {} of solid `{}` was {:.3e} m inside wall[{}]: the walls hold the \
-                 fluid, not the structure, so it passed through them and what followed is not the tank's physics \
-                 (summary.json solid_in_wall)",
+                "cosim: warning: at t = {} s node {} of solid `{}` was {:.3e} m inside wall[{}]: deeper than the \
+                 walls' contact leaves a surface node, so it went past it, and what followed is not the tank's \
+                 physics (summary.json solid_in_wall)",
                 cosim_proto::Num(e.t),
                 e.node,
                 e.solid,

@@ -15,6 +15,7 @@ use super::step_time::Step;
 use crate::interface::{Corrections, Interface, PassStats};
 use crate::probes::LoadLog;
 use crate::summary::{ContactStats, Summary};
+use crate::wall_contact::WallContact;
 
 /// The contact between the structure and the fluid, and what one pass leaves for the next step.
 pub(super) struct ContactPass {
@@ -33,6 +34,10 @@ pub(super) struct ContactPass {
     pub exchanged: u64,
     /// What the last pass did.
     pub last: PassStats,
+    /// The walls against the structure's interface nodes (`wall_contact.rs`); `None` without walls or nodes to stop.
+    walls: Option<WallContact>,
+    /// The walls have stopped a node in this process's run (logged once).
+    walls_stopped: bool,
 }
 
 impl ContactPass {
@@ -42,6 +47,10 @@ impl ContactPass {
             (Some(f), Some(p)) => Some(Interface::new(scene, f.setup(), p.setup())?),
             _ => None,
         };
+        let walls = interface.as_ref().and_then(|i| {
+            let mesh = nodes.fem.as_ref().expect("interface has a structure").setup();
+            WallContact::new(scene, mesh, i.node_ids())
+        });
         let roi = interface.as_ref().map(|i| {
             let mesh = nodes.fem.as_ref().expect("interface has a structure").setup();
             let x: Vec<[f64; 2]> = i.node_ids().iter().map(|&id| mesh.nodes[id as usize]).collect();
@@ -59,6 +68,8 @@ impl ContactPass {
                 .map_or_else(Vec::new, |f| f.setup().node_solid.clone()),
             exchanged: 0,
             last: PassStats::default(),
+            walls,
+            walls_stopped: false,
         })
     }
 
@@ -116,6 +127,18 @@ impl ContactPass {
                 cosim_proto::Num(t)
             )
         })?;
+        let mut corrections = corrections;
+        if let Some(walls) = &self.walls {
+            let stopped = walls.correct(fem, &mut corrections.fem);
+            if stopped > 0 && !self.walls_stopped {
+                self.walls_stopped = true;
+                tracing::info!(
+                    "t = {} s: the walls stop the structure ({stopped} node(s) put back on a wall's surface; \
+                     wall_contact.rs)",
+                    cosim_proto::Num(t)
+                );
+            }
+        }
         self.pending = corrections;
         self.last = stats.clone();
         self.roi = Some(interface.roi(&fem.x));

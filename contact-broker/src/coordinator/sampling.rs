@@ -126,9 +126,9 @@ impl<'s> Outputs<'s> {
         if let (Some(watch), Some((mesh, snap)), None) = (&self.wall_watch, fem, &summary.solid_in_wall) {
             summary.solid_in_wall = watch.observe(t, &snap.x, mesh).inspect(|e| {
                 tracing::warn!(
-                    "at t = {} s node {} of solid `{}` is {:.3e} m inside wall[{}]: the walls hold the fluid, not the \
-                     structure, so it passes through them and what follows is not the tank's physics (summary.json \
-                     solid_in_wall)",
+                    "at t = {} s node {} of solid `{}` is {:.3e} m inside wall[{}]: deeper than the walls' contact leaves \
+                     a surface node (wall_contact.rs), so it went past it, and what follows is not the tank's physics \
+                     (summary.json solid_in_wall)",
                     Num(e.t),
                     e.node,
                     e.solid,

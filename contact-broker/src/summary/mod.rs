@@ -106,8 +106,8 @@ pub struct Summary {
     /// `--record`: what the trace holds, and why it stopped before the run's end if it did; `null` without it.
     #[serde(default)]
     pub trace: Option<TraceNote>,
-    /// The first structure node found inside a wall at an output time (`wall_entry.rs`: the walls hold the fluid,
-    /// not the structure); `null` where none was.
+    /// The first structure node found inside a wall at an output time, deeper than the walls' contact leaves one
+    /// (`wall_entry.rs`); `null` where none was.
     #[serde(default)]
     pub solid_in_wall: Option<crate::wall_entry::WallEntry>,
 }

@@ -1,18 +1,19 @@
 //! A solid held nowhere: what a user should know before gravity moves it as a whole.
 //!
-//! The walls (`[[wall]]`) are the fluid's boundary particles; the structure node knows nothing of them. A solid with
-//! no `fixed` box is moved by gravity and the water alone, and where it reaches a wall it passes through it, the
-//! water caught between the two squeezed without bound. Measured (2026-12-07, a random sweep of coupled scenes): a
-//! free aluminium-dense block 9 × 4 cm dropped beside the shipped gate's column fell 5 cm through the air onto the
-//! surge along the floor and drove it into the floor's particles, the fluid gaining 1.8 times the energy the water
-//! can release before the fluid node stopped the run (`unstable`) at t = 0.1 s. A floating body lighter than the
-//! water is a legitimate scene, so this is a warning, not a refusal.
+//! A solid with no `fixed` box is moved by gravity and the water alone, and only the walls (`[[wall]]`) stop it:
+//! the broker puts its surface nodes back on a wall's surface without friction or rebound (`contact-broker`
+//! `wall_contact.rs`; before 2026-12-07 it passed through them). Such a body sinks or floats, and the water caught
+//! under one that falls is squeezed hard: measured (2026-12-07, a random sweep of coupled scenes), an aluminium-dense
+//! block 9 × 4 cm dropped 5 cm beside the shipped gate's column onto the surge along the floor made 15 times the
+//! energy the water can release with WCSPH (thrown back up) and ended `unstable` with ISPH, a shorter coupling step
+//! the first thing to try. A floating body lighter than the water is a legitimate scene, so this is a warning, not a
+//! refusal.
 
 use super::schema::Scene;
 
 impl Scene {
-    /// One warning per solid with no `fixed` box under a non-zero gravity, in the scene's order, saying that the
-    /// walls do not hold it and whether it is heavier or lighter than the scene's fluid.
+    /// One warning per solid with no `fixed` box under a non-zero gravity, in the scene's order, saying what moves
+    /// and stops it and whether it is heavier or lighter than the scene's fluid.
     pub fn unheld_solid_warnings(&self) -> Vec<String> {
         if self.run.gravity == [0.0, 0.0] {
             return Vec::new();
@@ -33,9 +34,10 @@ impl Scene {
                     None => "with no fluid, it falls freely".to_string(),
                 };
                 format!(
-                    "solid `{}` is held nowhere (no `fixed` box): gravity and the water move it as a whole, and the \
-                     walls act on the fluid only, so where it reaches a wall it passes through it, the water between \
-                     them squeezed without bound; {fate}",
+                    "solid `{}` is held nowhere (no `fixed` box): gravity and the water move it as a whole and only \
+                     the walls stop it, without friction or rebound (water caught under a falling solid is squeezed \
+                     hard: a shorter coupling.max_dt is the first thing to try if the run warns of energy made); \
+                     {fate}",
                     s.name
                 )
             })
