@@ -9,9 +9,16 @@
 //! velocity component into it: a frictionless, perfectly inelastic contact with an immovable body,
 //! the one the particle–element contact applies to a particle against a fixed master (`DESIGN.md` §4.5), here with
 //! the wall as the master. The walls take the momentum, as fixed nodes do. A node enters a wall by at most its
-//! displacement over one coupling step before it is put back. Of the shipped scenes only the gate reaches one: its
-//! free end starts on the floor's face and dipped up to 3.6 µm into it before (the tip_x peak 0.0388844 → 0.0388932 m
-//! at 0.11 s); the obstacle and the plate compute the same bits with and without it.
+//! displacement over one coupling step before it is put back.
+//!
+//! Not stopped: a node inside a wall from the start (a clamped end's neighbours), and a node of a clamped solid
+//! within half a fluid spacing of a wall from the start. The shipped gate hangs from its wall with its free end on the
+//! floor's face, and dipped up to 3.6 µm into it; stopping that end there (the floor a frictionless prop under the
+//! tip) made energy: at Δx = 4 mm to 0.05 s, 0.137 of the water's releasable energy against 0.0004 without, 19 %
+//! more fluid steps, the tip_x at 0.05 s 1.5 % further (why was not found). So a clamped structure the scene puts
+//! against a wall moves as before; one that comes to a wall, and every free solid (resting on the floor from the
+//! start: held within 0.6 µm for 0.1 s, no energy made), is stopped. Every shipped scene computes the same bits with
+//! and without it.
 
 use cosim_proto::messages::{Correction, FemMesh, FemState};
 use cosim_proto::scene::Scene;
@@ -83,18 +90,35 @@ fn exit_point(p: [f64; 2], walls: &[([f64; 2], [f64; 2])], hair: f64) -> Option<
 impl WallContact {
     /// The walls of `scene` against the interface nodes `ids` of `mesh`; `None` without walls or nodes to stop.
     pub fn new(scene: &Scene, mesh: &FemMesh, ids: &[u32]) -> Option<Self> {
+        let spacing = scene.fluid.as_ref()?.spacing;
         if scene.walls.is_empty() {
             return None;
         }
         let walls: Vec<_> = scene.walls.iter().map(|w| (w.min, w.max)).collect();
+        // The solids with a clamp.
+        let held: Vec<bool> = (0..mesh.solid_names.len())
+            .map(|k| {
+                mesh.fixed
+                    .iter()
+                    .any(|&f| mesh.node_solid.get(f as usize) == Some(&(k as u32)))
+            })
+            .collect();
         let stopped: Vec<bool> = ids
             .iter()
             .map(|&id| {
-                let p = mesh.nodes.get(id as usize).copied();
+                let Some(&p) = mesh.nodes.get(id as usize) else {
+                    return false;
+                };
                 let fixed = mesh.fixed.contains(&id);
-                // A node on a wall's face (depth 0) is stopped; one inside it from the start (a clamped end's
-                // neighbours) is left as the scene put it.
-                !fixed && p.is_some_and(|p| walls.iter().all(|&w| depth(p, w) <= 0.0))
+                let solid_held = mesh
+                    .node_solid
+                    .get(id as usize)
+                    .is_some_and(|&k| held.get(k as usize) == Some(&true));
+                let deepest = walls.iter().map(|&w| depth(p, w)).fold(f64::NEG_INFINITY, f64::max);
+                // Inside a wall from the start (a clamped end's neighbours): left as the scene put it. A clamped
+                // solid's node within half a spacing of a wall from the start (the gate's free end on the floor's
+                // face) too: stopping it there made energy (the module docs).
+                !fixed && deepest <= 0.0 && !(solid_held && deepest >= -0.5 * spacing)
             })
             .collect();
         // A hair: far below any wall's size, far above the coordinates' round-off.
@@ -201,10 +225,14 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
 
     #[test]
     fn a_node_in_a_wall_is_put_on_its_face_and_stops_going_in() {
-        // Node 0 on the floor's face, 1 above it, 2 fixed, 3 inside the floor from the start.
-        let m = mesh(vec![[0.5, 0.0], [0.5, 0.05], [0.6, 0.0], [0.7, -0.01]], vec![2]);
-        let walls = WallContact::new(&scene(), &m, &[0, 1, 2, 3]).expect("two nodes to stop");
-        assert_eq!(walls.stopped, [true, true, false, false]);
+        // Node 0 on the floor's face, 1 above it, 2 fixed, 3 inside the floor from the start. Clamped by node 2, the
+        // solid's node 0 on the face is left alone too (the gate's free end on the floor); free, it is stopped.
+        let nodes = vec![[0.5, 0.0], [0.5, 0.05], [0.6, 0.0], [0.7, -0.01]];
+        let held = WallContact::new(&scene(), &mesh(nodes.clone(), vec![2]), &[0, 1, 2, 3]).expect("node 1 to stop");
+        assert_eq!(held.stopped, [false, true, false, false]);
+        let m = mesh(nodes, Vec::new());
+        let walls = WallContact::new(&scene(), &m, &[0, 1, 2, 3]).expect("three nodes to stop");
+        assert_eq!(walls.stopped, [true, true, true, false]);
         // Node 0 2 mm into the floor, going down and right; the pass moved it 1 mm further down already.
         let mut c = vec![Correction {
             id: 0,
@@ -213,7 +241,7 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
             face: None,
         }];
         let s = state(
-            vec![[0.5, -0.002], [0.5, 0.05], [0.6, -0.01], [0.7, -0.02]],
+            vec![[0.5, -0.002], [0.5, 0.05], [0.6, 0.01], [0.7, -0.02]],
             vec![[0.3, -1.0], [0.0, -1.0], [0.0, -1.0], [0.0, -1.0]],
         );
         assert_eq!(walls.correct(&s, &mut c), 1);
@@ -234,7 +262,7 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
         // wall's face there lies against the floor), the velocity into the corner taken off.
         let mut c = Vec::new();
         let s = state(
-            vec![[1.002, -0.001], [0.5, 0.05], [0.6, 0.0], [0.7, -0.01]],
+            vec![[1.002, -0.001], [0.5, 0.05], [0.6, 0.01], [0.7, -0.01]],
             vec![[1.0, -1.0]; 4],
         );
         walls.correct(&s, &mut c);
@@ -249,7 +277,7 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
         // On the shared face of the two walls, below the floor's top: inside their union, put out too.
         let mut c = Vec::new();
         let s = state(
-            vec![[1.0, -0.001], [0.5, 0.05], [0.6, 0.0], [0.7, -0.01]],
+            vec![[1.0, -0.001], [0.5, 0.05], [0.6, 0.01], [0.7, -0.01]],
             vec![[0.0, -1.0]; 4],
         );
         walls.correct(&s, &mut c);
