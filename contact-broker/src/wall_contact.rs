@@ -35,7 +35,7 @@ pub struct WallContact {
 }
 
 /// How far `p` lies inside the box `lo`–`hi` (0 on its boundary, negative outside).
-fn depth(p: [f64; 2], (lo, hi): ([f64; 2], [f64; 2])) -> f64 {
+pub(crate) fn depth(p: [f64; 2], (lo, hi): ([f64; 2], [f64; 2])) -> f64 {
     (p[0] - lo[0]).min(hi[0] - p[0]).min(p[1] - lo[1]).min(hi[1] - p[1])
 }
 
@@ -163,10 +163,11 @@ impl WallContact {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn mesh(nodes: Vec<[f64; 2]>, fixed: Vec<u32>) -> FemMesh {
+    /// One solid, `block`, of unit masses at `nodes`, clamped at `fixed`.
+    pub(crate) fn mesh(nodes: Vec<[f64; 2]>, fixed: Vec<u32>) -> FemMesh {
         let n = nodes.len();
         FemMesh {
             solid_names: vec!["block".into()],
@@ -193,7 +194,8 @@ mod tests {
         }
     }
 
-    fn scene() -> Scene {
+    /// A floor (to x = 1 m) and a side wall beyond it, a fluid of spacing 0.01 m, the solid `block`.
+    pub(crate) fn scene() -> Scene {
         let text = r#"
 version = 1
 [run]

@@ -14,6 +14,8 @@ use cosim_proto::messages::FemMesh;
 use cosim_proto::scene::Scene;
 use serde::{Deserialize, Serialize};
 
+use crate::wall_contact::depth;
+
 /// The first structure node found inside a wall.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WallEntry {
@@ -39,11 +41,6 @@ pub struct WallWatch {
     watched: Vec<bool>,
 }
 
-/// How far `p` lies inside the box `lo`–`hi` (negative: outside, by at least that much along one axis).
-fn depth(p: [f64; 2], lo: [f64; 2], hi: [f64; 2]) -> f64 {
-    (p[0] - lo[0]).min(hi[0] - p[0]).min(p[1] - lo[1]).min(hi[1] - p[1])
-}
-
 impl WallWatch {
     /// The watch for the scene's walls over the structure `mesh`; `None` without walls, fluid or nodes.
     pub fn new(scene: &Scene, mesh: &FemMesh) -> Option<Self> {
@@ -56,7 +53,7 @@ impl WallWatch {
         let watched = mesh
             .nodes
             .iter()
-            .map(|&p| walls.iter().all(|&(lo, hi)| depth(p, lo, hi) < -margin))
+            .map(|&p| walls.iter().all(|&w| depth(p, w) < -margin))
             .collect();
         Some(Self { walls, margin, watched })
     }
@@ -72,7 +69,7 @@ impl WallWatch {
                 .walls
                 .iter()
                 .enumerate()
-                .map(|(w, &(lo, hi))| (w, depth(p, lo, hi)))
+                .map(|(w, &b)| (w, depth(p, b)))
                 .find(|&(_, d)| d > self.margin)?;
             let solid = mesh
                 .node_solid
@@ -94,53 +91,12 @@ impl WallWatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn mesh(nodes: Vec<[f64; 2]>) -> FemMesh {
-        let n = nodes.len();
-        FemMesh {
-            solid_names: vec!["block".into()],
-            nodes,
-            masses: vec![1.0; n],
-            node_solid: vec![0; n],
-            cells: Vec::new(),
-            cell_solid: Vec::new(),
-            interface: Vec::new(),
-            fixed: Vec::new(),
-            dt_stable: 1e-6,
-        }
-    }
-
-    fn scene() -> Scene {
-        let text = r#"
-version = 1
-[run]
-name = "t"
-end_time = 0.1
-output_interval = 0.01
-[fluid]
-density = 1000.0
-spacing = 0.01
-[[fluid.block]]
-min = [0.0, 0.0]
-max = [0.1, 0.1]
-[[wall]]
-min = [-0.03, -0.03]
-max = [1.0, 0.0]
-[[solid]]
-name = "block"
-min = [0.5, 0.0]
-max = [0.6, 0.05]
-divisions = [2, 1]
-element = "quad4"
-material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, poisson_ratio = 0.3 }
-"#;
-        cosim_proto::scene::parse("t.toml", text, &[]).unwrap()
-    }
+    use crate::wall_contact::tests::{mesh, scene};
 
     #[test]
     fn a_node_deeper_than_half_a_spacing_in_a_wall_is_found_once_it_goes_there() {
         // One node on the floor's face (not watched), one above it.
-        let m = mesh(vec![[0.5, 0.0], [0.5, 0.05]]);
+        let m = mesh(vec![[0.5, 0.0], [0.5, 0.05]], Vec::new());
         let watch = WallWatch::new(&scene(), &m).expect("walls and a fluid");
         assert!(watch.observe(0.0, &m.nodes, &m).is_none());
         // The node on the face sinks in: it started on the wall, so it is not watched.
