@@ -26,17 +26,32 @@ use cosim_proto::scene::Scene;
 /// The walls' boxes and which interface nodes they stop.
 #[derive(Clone, Debug)]
 pub struct WallContact {
-    walls: Vec<([f64; 2], [f64; 2])>,
+    walls: Vec<WallBox>,
     /// Per interface node (in the order of the interface's ids): stopped by the walls (not fixed, not inside a wall
     /// in the mesh as the scene made it).
     stopped: Vec<bool>,
     /// How far from a candidate exit point the union's outside is looked for [m].
     hair: f64,
+    /// Scratch of [`WallContact::correct`]: the pass's corrections summed per interface node, (dx, dv).
+    moved_by: Vec<([f64; 2], [f64; 2])>,
+}
+
+/// A wall's box, (lower corner, upper corner).
+pub(crate) type WallBox = ([f64; 2], [f64; 2]);
+
+/// The scene's walls as boxes, in its order (`wall[k]`).
+pub(crate) fn wall_boxes(scene: &Scene) -> Vec<WallBox> {
+    scene.walls.iter().map(|w| (w.min, w.max)).collect()
 }
 
 /// How far `p` lies inside the box `lo`–`hi` (0 on its boundary, negative outside).
-pub(crate) fn depth(p: [f64; 2], (lo, hi): ([f64; 2], [f64; 2])) -> f64 {
+pub(crate) fn depth(p: [f64; 2], (lo, hi): WallBox) -> f64 {
     (p[0] - lo[0]).min(hi[0] - p[0]).min(p[1] - lo[1]).min(hi[1] - p[1])
+}
+
+/// The largest [`depth`] of `p` in any of `walls` (−∞ without walls).
+pub(crate) fn deepest(p: [f64; 2], walls: &[WallBox]) -> f64 {
+    walls.iter().map(|&w| depth(p, w)).fold(f64::NEG_INFINITY, f64::max)
 }
 
 /// The nearest point to `p` on the boundary of the union of the `walls` when `p` lies in one of them (their closed
@@ -45,7 +60,7 @@ pub(crate) fn depth(p: [f64; 2], (lo, hi): ([f64; 2], [f64; 2])) -> f64 {
 /// and every box's corners, and one counts only where a point a hair away from it, along an axis or a diagonal,
 /// lies outside every wall. Ties go to the first candidate (boxes in the scene's order, faces −x, +x, −y, +y, then
 /// the corners).
-fn exit_point(p: [f64; 2], walls: &[([f64; 2], [f64; 2])], hair: f64) -> Option<[f64; 2]> {
+fn exit_point(p: [f64; 2], walls: &[WallBox], hair: f64) -> Option<[f64; 2]> {
     if walls.iter().all(|&w| depth(p, w) < 0.0) {
         return None;
     }
@@ -94,7 +109,7 @@ impl WallContact {
         if scene.walls.is_empty() {
             return None;
         }
-        let walls: Vec<_> = scene.walls.iter().map(|w| (w.min, w.max)).collect();
+        let walls = wall_boxes(scene);
         // The solids with a clamp.
         let held: Vec<bool> = (0..mesh.solid_names.len())
             .map(|k| {
@@ -114,7 +129,7 @@ impl WallContact {
                     .node_solid
                     .get(id as usize)
                     .is_some_and(|&k| held.get(k as usize) == Some(&true));
-                let deepest = walls.iter().map(|&w| depth(p, w)).fold(f64::NEG_INFINITY, f64::max);
+                let deepest = deepest(p, &walls);
                 // Inside a wall from the start (a clamped end's neighbours): left as the scene put it. A clamped
                 // solid's node within half a spacing of a wall from the start (the gate's free end on the floor's
                 // face) too: stopping it there made energy (the module docs).
@@ -126,24 +141,38 @@ impl WallContact {
             m.max(lo[0].abs()).max(lo[1].abs()).max(hi[0].abs()).max(hi[1].abs())
         });
         let hair = 1e-9 * scale;
-        stopped.iter().any(|&s| s).then_some(Self { walls, stopped, hair })
+        stopped.iter().any(|&s| s).then_some(Self {
+            walls,
+            stopped,
+            hair,
+            moved_by: Vec::new(),
+        })
     }
 
     /// The corrections that put the interface nodes of `state` (positions and velocities at the end of the step,
     /// plus the contact pass's `corrections` to them) back out of the walls, appended to `corrections`; how many
     /// nodes it moved.
-    pub fn correct(&self, state: &FemState, corrections: &mut Vec<Correction>) -> usize {
+    pub fn correct(&mut self, state: &FemState, corrections: &mut Vec<Correction>) -> usize {
+        // The pass's corrections per node in one walk over them (`state.ids` ascending, as the interface reports
+        // them), not one walk per node: this runs after every contact pass.
+        self.moved_by.clear();
+        self.moved_by.resize(state.ids.len(), ([0.0; 2], [0.0; 2]));
+        for c in corrections.iter() {
+            if let Ok(k) = state.ids.binary_search(&c.id) {
+                let (dx, dv) = &mut self.moved_by[k];
+                *dx = [dx[0] + c.dx[0], dx[1] + c.dx[1]];
+                *dv = [dv[0] + c.dv[0], dv[1] + c.dv[1]];
+            }
+        }
         let mut moved = 0;
         for (k, &id) in state.ids.iter().enumerate() {
             if !self.stopped.get(k).copied().unwrap_or(false) {
                 continue;
             }
             // The node as the next step will start it: the pass's corrections to it added.
-            let (mut p, mut u) = (state.x[k], state.v[k]);
-            for c in corrections.iter().filter(|c| c.id == id) {
-                p = [p[0] + c.dx[0], p[1] + c.dx[1]];
-                u = [u[0] + c.dv[0], u[1] + c.dv[1]];
-            }
+            let (dx, dv) = self.moved_by[k];
+            let (p, u) = (state.x[k], state.v[k]);
+            let (p, u) = ([p[0] + dx[0], p[1] + dx[1]], [u[0] + dv[0], u[1] + dv[1]]);
             let Some(c) = exit_point(p, &self.walls, self.hair) else {
                 continue;
             };
@@ -233,7 +262,7 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
         let held = WallContact::new(&scene(), &mesh(nodes.clone(), vec![2]), &[0, 1, 2, 3]).expect("node 1 to stop");
         assert_eq!(held.stopped, [false, true, false, false]);
         let m = mesh(nodes, Vec::new());
-        let walls = WallContact::new(&scene(), &m, &[0, 1, 2, 3]).expect("three nodes to stop");
+        let mut walls = WallContact::new(&scene(), &m, &[0, 1, 2, 3]).expect("three nodes to stop");
         assert_eq!(walls.stopped, [true, true, true, false]);
         // Node 0 2 mm into the floor, going down and right; the pass moved it 1 mm further down already.
         let mut c = vec![Correction {

@@ -14,7 +14,7 @@ use cosim_proto::messages::FemMesh;
 use cosim_proto::scene::Scene;
 use serde::{Deserialize, Serialize};
 
-use crate::wall_contact::depth;
+use crate::wall_contact::{deepest, depth, wall_boxes, WallBox};
 
 /// The first structure node found inside a wall.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -34,7 +34,7 @@ pub struct WallEntry {
 /// The walls' boxes and which nodes are watched.
 #[derive(Clone, Debug)]
 pub struct WallWatch {
-    walls: Vec<([f64; 2], [f64; 2])>,
+    walls: Vec<WallBox>,
     /// Half the fluid spacing: deeper than this is inside.
     margin: f64,
     /// Per node: watched (not within `margin` of a wall where the scene put it).
@@ -48,13 +48,9 @@ impl WallWatch {
         if scene.walls.is_empty() || mesh.nodes.is_empty() {
             return None;
         }
-        let walls: Vec<_> = scene.walls.iter().map(|w| (w.min, w.max)).collect();
+        let walls = wall_boxes(scene);
         let margin = 0.5 * fluid.spacing;
-        let watched = mesh
-            .nodes
-            .iter()
-            .map(|&p| walls.iter().all(|&w| depth(p, w) < -margin))
-            .collect();
+        let watched = mesh.nodes.iter().map(|&p| deepest(p, &walls) < -margin).collect();
         Some(Self { walls, margin, watched })
     }
 

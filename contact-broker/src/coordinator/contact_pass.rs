@@ -47,12 +47,11 @@ impl ContactPass {
             (Some(f), Some(p)) => Some(Interface::new(scene, f.setup(), p.setup())?),
             _ => None,
         };
-        let walls = interface.as_ref().and_then(|i| {
-            let mesh = nodes.fem.as_ref().expect("interface has a structure").setup();
-            WallContact::new(scene, mesh, i.node_ids())
-        });
-        let roi = interface.as_ref().map(|i| {
-            let mesh = nodes.fem.as_ref().expect("interface has a structure").setup();
+        let mesh = interface
+            .as_ref()
+            .map(|i| (i, nodes.fem.as_ref().expect("interface has a structure").setup()));
+        let walls = mesh.and_then(|(i, mesh)| WallContact::new(scene, mesh, i.node_ids()));
+        let roi = mesh.map(|(i, mesh)| {
             let x: Vec<[f64; 2]> = i.node_ids().iter().map(|&id| mesh.nodes[id as usize]).collect();
             i.roi(&x)
         });
@@ -121,14 +120,13 @@ impl ContactPass {
             return Ok(());
         };
         let started = Instant::now();
-        let (corrections, stats) = interface.pass(fem, sph, step.dt).with_context(|| {
+        let (mut corrections, stats) = interface.pass(fem, sph, step.dt).with_context(|| {
             format!(
                 "contact pass of coupling step {number} at t = {} s",
                 cosim_proto::Num(t)
             )
         })?;
-        let mut corrections = corrections;
-        if let Some(walls) = &self.walls {
+        if let Some(walls) = self.walls.as_mut() {
             let stopped = walls.correct(fem, &mut corrections.fem);
             if stopped > 0 && !self.walls_stopped {
                 self.walls_stopped = true;

@@ -8,7 +8,7 @@
 //! - `grid.rs`: the FEM grid numbering of a solid;
 //! - `sensors.rs`: the pressure sensors a fluid node samples every step (interval-mean pressure probes);
 //! - `impact.rs`: the warning for WCSPH pressure probes on a side wall (what an impact reads there);
-//! - `unheld.rs`: the warning for a solid with no `fixed` box (the walls do not hold it);
+//! - `unheld.rs`: the warning for a solid with no `fixed` box (gravity and the water move it; only the walls stop it);
 //! - `warnings.rs`: the warnings `cosim check` and `cosim run` both give;
 //! - [`sizing`]: counts and bytes of a run, estimated from the scene alone.
 //!
