@@ -129,7 +129,7 @@ fn a_run_that_makes_energy_says_so() {
         out.stderr
     );
     assert!(
-        out.stderr.contains("--set solid[0].mesh_damping=0.25"),
+        out.stderr.contains("--set solid[0].mesh_damping=0.02"),
         "{case}: the mesh damping not suggested; stderr: {}",
         out.stderr
     );
