@@ -224,13 +224,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
                      (now {c})"
                 );
             }
-            // A structure whose highest modes grow: its sub-steps follow the coupling step, which follows the
-            // fluid's, and a central difference whose step changes from call to call is unstable there
-            // (docs/CORRECTIONS.md "The structure's sub-steps of changing length").
+            // A structure whose mesh rings under the contact's impulses: a tenth of the damping first measured holds
+            // it as well (docs/CORRECTIONS.md "The structure's sub-steps of changing length").
             if let Some(i) = scene.scene.solids.iter().position(|s| s.mesh_damping == 0.0) {
                 eprintln!(
-                    "cosim: so is damping the structure's highest modes, which its sub-steps of changing length make \
-                     grow, --set solid[{i}].mesh_damping=0.02 (docs/CORRECTIONS.md)"
+                    "cosim: so is damping the structure's mesh-scale ringing, --set solid[{i}].mesh_damping=0.02 \
+                     (docs/CORRECTIONS.md)"
                 );
             }
         }
