@@ -1,14 +1,16 @@
 //! The structure's sub-step changes from one coupling step to the next (it is the coupling step, set by the fluid,
 //! over a whole number of sub-steps), and the central difference at a step that changes so is unstable in the mesh's
 //! highest modes, each step stable on its own: a product of symplectic maps of different steps grows (for one
-//! oscillator at ω Δt = 1.8, steps varying by 10 % between calls: ×1e41 in 20,000 calls). `solid.mesh_damping =
+//! oscillator at ω Δt = 1.8, steps varying by 10 % between calls: ×1e41 in 20,000 calls,
+//! `docs/experiments/varying_steps_oscillator.py`). `solid.mesh_damping =
 //! 0.02` (a damping ratio of 0.02 at the mesh's highest mode, what `cosim run` suggests after a run that made
 //! energy) holds them (docs/CORRECTIONS.md "The structure's sub-steps of changing length").
 //!
 //! The case: the free 2,700 kg/m³ block of the coupled-scene sweep (87 × 39 mm, 40 × 20 cells, E = 12 MPa, ν = 0.4,
-//! neo-Hookean) ringing, 3 m/s along its length and ±1 m/s node to node, as after its slam onto the water, advanced to 0.2 s at
-//! the default `fem_cfl` 0.9 in coupling steps drawn from [1e-5, 6e-5] s (a WCSPH fluid's steps after an impact
-//! were 2.1–5.5e-5 s), about 6,500 of them, against the same at a steady 3.5e-5 s. Measured (2026-12-07):
+//! neo-Hookean) ringing, 3 m/s along its length and ±1 m/s node to node, as after its slam onto the water,
+//! advanced to 0.2 s at the default `fem_cfl` 0.9 in coupling steps drawn from [1e-5, 6e-5] s (a WCSPH fluid's
+//! steps after an impact were 2.1–5.5e-5 s), about 6,500 of them, against the same at a steady 3.5e-5 s. Measured
+//! (2026-12-07):
 //! undamped, a steady step keeps the energy (largest 1.023 / 1.009 of the start, tri3 / quad4) and changing steps
 //! make it grow until an element inverts (tri3) or 17.6-fold (quad4); with ζ = 0.02 the energy ends at 0.615 of its
 //! start at either (the damping takes the rough part of the field and some of the smooth one) and never passes it.
@@ -28,8 +30,7 @@ fn draw(i: u64, salt: u64) -> f64 {
 }
 
 /// (largest, last) total energy over its start for the ringing block advanced in coupling steps of changing length
-/// (`changing`) or of 3.5e-5 s each;
-/// infinite where an element inverted.
+/// (`changing`) or of 3.5e-5 s each; infinite where an element inverted.
 fn ringing_block(element: ElementKind, mesh_damping: f64, changing: bool) -> (f64, f64) {
     let mut spec = cantilever(
         [0.0, 0.0867],
