@@ -71,7 +71,7 @@ impl Scene {
                     "a fluid particle weighs {:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
-                     the solid's divisions, refine fluid.spacing, damp the ringing ({}.mesh_damping = 0.25) or spread \
+                     the solid's divisions, refine fluid.spacing, damp the ringing ({}.mesh_damping = 0.02) or spread \
                      the load (contact.load_spread = 2; docs/CORRECTIONS.md)",
                     Num(ratio),
                     self.solid_key(name)
@@ -115,7 +115,7 @@ impl Scene {
                  fluid particle weighs {:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
                  step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
                  free, made the 4 mm gate unstable without a bound from the structure's speed); try coupling.max_dt = \
-                 {:.0e}, or damp the structure's ringing ({}.mesh_damping = 0.25: the 4 mm gate then ends at ISPH's own \
+                 {:.0e}, or damp the structure's ringing ({}.mesh_damping = 0.02: the 4 mm gate then ends at ISPH's own \
                  step; docs/CORRECTIONS.md){}",
                 Num(ratio),
                 24.0 * fem_dt,
