@@ -7,9 +7,9 @@
 //! block 9 × 4 cm dropped 5 cm beside the shipped gate's column onto the surge along the floor made 15 times the
 //! energy the water can release with WCSPH (thrown back up) and ended `unstable` with ISPH, a shorter coupling step
 //! the first thing to try: 1.17 / 0.95 times at `coupling.max_dt` 2e-5 / 1e-5 s, 2.3 times with its mesh damped
-//! (`mesh_damping = 0.02`, which holds the ringing of the block thrown clear of the water, 10 of the 15; docs/CORRECTIONS.md
-//! "The structure's sub-steps of changing length"). What is left is the slam itself: the block reaches the floor with
-//! particles under it, which the contact and the walls squeeze between them (not fixed). A floating body lighter than
+//! (`mesh_damping = 0.02`: the ringing of the block once thrown clear of the water made most of the 15;
+//! docs/CORRECTIONS.md "The structure's sub-steps of changing length"). What is left is the slam itself: the block
+//! reaches the floor with particles under it, which the contact and the walls squeeze between them (not fixed). A floating body lighter than
 //! the water is a legitimate scene, so this is a warning, not a refusal.
 
 use super::schema::Scene;
