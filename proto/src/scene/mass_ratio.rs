@@ -137,7 +137,7 @@ impl Scene {
     }
 
     /// `solid[i]`, the key of the solid named `name`.
-    pub(super) fn solid_key(&self, name: &str) -> String {
+    fn solid_key(&self, name: &str) -> String {
         let i = self.solids.iter().position(|s| s.name == name).unwrap_or(0);
         format!("solid[{i}]")
     }

@@ -23,8 +23,9 @@ impl Scene {
         }
         self.solids
             .iter()
-            .filter(|s| s.fixed.is_empty())
-            .map(|s| {
+            .enumerate()
+            .filter(|(_, s)| s.fixed.is_empty())
+            .map(|(i, s)| {
                 let rho_s = s.material.density;
                 let fate = match &self.fluid {
                     Some(f) if rho_s > f.density => {
@@ -40,9 +41,8 @@ impl Scene {
                     "solid `{}` is held nowhere (no `fixed` box): gravity and the water move it as a whole and only \
                      the walls stop it, without friction or rebound (water caught under a falling solid is squeezed \
                      hard: a shorter coupling.max_dt is the first thing to try if the run warns of energy made, then \
-                     {}.mesh_damping = 0.02); {fate}",
-                    s.name,
-                    self.solid_key(&s.name)
+                     solid[{i}].mesh_damping = 0.02); {fate}",
+                    s.name
                 )
             })
             .collect()
