@@ -74,22 +74,30 @@ pub fn ctl(args: &CtlArgs) -> anyhow::Result<ExitCode> {
 fn wait_paused(session: &Session, id: &str, timeout: Duration, first: ControlReply) -> ControlReply {
     let mut last = first;
     let started = Instant::now();
+    let alive = key(id, topic::BROKER_ALIVE);
     while last.paused.is_empty() {
         match ask(session, id, ControlCommand::Status, timeout) {
             Ok(reply) => last = reply,
             Err(e) => {
-                last.ok = false;
-                let waited = started.elapsed().as_secs_f64();
                 // A run that reached its end before the steps asked were taken: its broker's token is gone (`cosim
-                // ctl RUN step N` beyond the run's end said only that the broker "did not answer within 10 s").
-                let alive = key(id, topic::BROKER_ALIVE);
-                last.message = match cosim_bus::claim::held(session, &alive, Duration::from_secs(2)) {
+                // ctl RUN step N` beyond the run's end said only that the broker "did not answer within 10 s"). A
+                // broker that has taken its control queryable down but still writes its outputs holds its token a
+                // little longer: ask again until the token goes or `timeout` has passed (a fresh clone's suite met
+                // that race once in four, 2026-12-07).
+                let held = cosim_bus::claim::held(session, &alive, Duration::from_secs(2));
+                let waited = started.elapsed();
+                if matches!(held, Ok(true)) && waited < timeout {
+                    std::thread::sleep(Duration::from_millis(50));
+                    continue;
+                }
+                last.ok = false;
+                last.message = match held {
                     Ok(false) => format!(
                         "the run ended before pausing again (its broker is gone; last seen at step {}, t = {} s)",
                         last.step,
                         cosim_proto::Num(cosim_proto::readable::significant(last.t, 12))
                     ),
-                    _ => format!("the run did not pause again after {waited:.1} s: {e:#}"),
+                    _ => format!("the run did not pause again after {:.1} s: {e:#}", waited.as_secs_f64()),
                 };
                 break;
             }
