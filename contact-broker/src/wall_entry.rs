@@ -14,7 +14,7 @@ use cosim_proto::messages::FemMesh;
 use cosim_proto::scene::Scene;
 use serde::{Deserialize, Serialize};
 
-use crate::wall_contact::{deepest, depth, wall_boxes, WallBox};
+use cosim_proto::walls::{deepest, depth, wall_boxes, WallBox};
 
 /// The first structure node found inside a wall.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

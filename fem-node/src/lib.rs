@@ -7,6 +7,7 @@
 //! * [`material`]: corotational linear elastic, neo-Hookean, St. Venant–Kirchhoff.
 //! * [`solver`]: stable step, central difference (kick–drift–kick), [`FemSolver`] with sub-cycling.
 //! * [`state::FemState`]: the serializable state, kept apart from per-step scratch.
+//! * [`walls`]: the tank's walls, which stop the structure's nodes inside every sub-step.
 #![warn(missing_docs)]
 
 pub mod core;
@@ -19,6 +20,7 @@ pub mod model;
 pub mod node;
 pub mod solver;
 pub mod state;
+pub mod walls;
 
 pub use error::{FemError, Result};
 pub use model::FemModel;

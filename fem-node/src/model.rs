@@ -9,6 +9,7 @@ use crate::element::{Element, Quad4, Tri3};
 use crate::error::{FemError, Result};
 use crate::material::Material;
 use crate::mesh::{structured_mesh, Cell};
+use crate::walls::WallStop;
 
 /// One solid of the model.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,12 +52,16 @@ pub struct FemModel {
     fixed: Vec<bool>,
     boundary: Vec<Segment>,
     gravity: [f64; 2],
+    /// The tank's walls, where the scene has a fluid and walls and a node they stop.
+    walls: Option<WallStop>,
 }
 
 impl FemModel {
     /// The model of a scene's `[[solid]]`s under `run.gravity`.
     pub fn build(scene: &Scene) -> Result<Self> {
-        Self::from_solids(&scene.solids, scene.run.gravity)
+        let mut model = Self::from_solids(&scene.solids, scene.run.gravity)?;
+        model.walls = WallStop::new(scene, &model.reference, &model.fixed, &model.node_solid);
+        Ok(model)
     }
 
     /// The model of some solids under `gravity` [m/s²].
@@ -71,6 +76,7 @@ impl FemModel {
             fixed: Vec::new(),
             boundary: Vec::new(),
             gravity,
+            walls: None,
         };
         if !gravity.iter().all(|g| g.is_finite()) {
             return Err(FemError::InvalidParameter {
@@ -236,6 +242,11 @@ impl FemModel {
     /// Gravity [m/s²].
     pub fn gravity(&self) -> [f64; 2] {
         self.gravity
+    }
+
+    /// The tank's walls, where they stop a node.
+    pub fn walls(&self) -> Option<&WallStop> {
+        self.walls.as_ref()
     }
 
     /// Element connectivity as id lists (the `fem/mesh` message layout).

@@ -12,6 +12,7 @@ pub mod run_status;
 pub mod scene;
 pub mod trace;
 pub mod validate;
+pub mod walls;
 
 pub use readable::{one_line, Num};
 pub use scene::sizing;

@@ -5,7 +5,8 @@
 //! `a^{n+1} = M⁻¹ (f_ext − f_int(x^{n+1})) − c v^{n+½}`, `v^{n+1} = v^{n+½} + Δt/2 a^{n+1}`.
 //!
 //! This is the central difference of Eq. (3), Long et al. 2016 (`v^{n+½} = v^{n−½} + Δt a^n` once the two
-//! half kicks are merged). Clamped nodes keep `x = X`, `v = 0`, `a = 0`.
+//! half kicks are merged). Clamped nodes keep `x = X`, `v = 0`, `a = 0`. A node the drift takes into a tank wall is
+//! put back on its surface and `v^{n+½}` loses its component into the wall (`crate::walls`).
 //!
 //! Stiffness-proportional (Rayleigh β) damping, where a solid has it (`mesh_damping`): `f_int` is taken at
 //! `x + β v` (with `v^{n+½}` in a step, as the mass-proportional term), which is `f_int(x) + β K(x) v + O(β²)`, the
@@ -98,6 +99,10 @@ pub fn step(
         v[1] += half * a[1];
         x[0] += dt * v[0];
         x[1] += dt * v[1];
+    }
+    // The walls stop the nodes the drift took into them (`crate::walls`), before the forces at x^{n+1}.
+    if let Some(walls) = model.walls() {
+        walls.apply(&mut state.x, &mut state.v);
     }
     // The damping forces use v^{n+½}, the latest velocity known before the closing kick.
     damped_internal_forces(model, &state.x, &state.v, scratch, parallel_min_elements)?;
