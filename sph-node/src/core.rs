@@ -105,7 +105,9 @@ impl SphCore {
             .fluid
             .as_ref()
             .and_then(|f| crate::setup::sound_speed(f, scene.run.gravity).ok());
-        let guard = EnergyGuard::new(solver.state(), solver.walls(), scene.run.gravity, c0);
+        // The budget counts what a solid held nowhere can give the water by sinking (`stability.rs`).
+        let bodies = crate::stability::free_solids(scene);
+        let guard = EnergyGuard::with_bodies(solver.state(), solver.walls(), scene.run.gravity, c0, &bodies);
         Ok(Self {
             solver,
             setup,

@@ -1,16 +1,18 @@
 //! A solid held nowhere: what a user should know before gravity moves it as a whole.
 //!
 //! A solid with no `fixed` box is moved by gravity and the water alone, and only the walls (`[[wall]]`) stop it:
-//! the broker puts its surface nodes back on a wall's surface without friction or rebound (`contact-broker`
-//! `wall_contact.rs`; before 2026-12-07 it passed through them). Such a body sinks or floats, and the water caught
-//! under one that falls is squeezed hard: measured (2026-12-07, a random sweep of coupled scenes), an aluminium-dense
-//! block 9 × 4 cm dropped 5 cm beside the shipped gate's column onto the surge along the floor made 15 times the
-//! energy the water can release with WCSPH (thrown back up) and ended `unstable` with ISPH, a shorter coupling step
-//! the first thing to try: 1.17 / 0.95 times at `coupling.max_dt` 2e-5 / 1e-5 s, 2.3 times with its mesh damped
-//! (`mesh_damping = 0.02`: the ringing of the block once thrown clear of the water made most of the 15;
-//! docs/CORRECTIONS.md "The structure's sub-steps of changing length"). What is left is the slam itself: the block
-//! reaches the floor with particles under it, which the contact and the walls squeeze between them (not fixed). A floating body lighter than
-//! the water is a legitimate scene, so this is a warning, not a refusal.
+//! a node that a step takes into a wall is put back on the wall's surface without friction or rebound of the node
+//! (`crate::walls`; fem-node within every sub-step, the broker after each contact pass; before 2026-12-07 a solid
+//! passed through the walls, and until 2026-12-08 the broker's once-a-step stop made energy as an elastic solid
+//! landed). Such a body sinks or floats, and the water caught under one that falls is squeezed hard: measured
+//! (2026-12-07, a random sweep of coupled scenes), an aluminium-dense block 9 × 4 cm dropped 5 cm beside the shipped
+//! gate's column onto the surge along the floor made 15 times the energy the water can release with WCSPH (thrown
+//! back up; 9.0 times since 2026-12-08) and ended `unstable` with ISPH, a shorter coupling step the first thing to
+//! try: 1.17 / 0.95 times at `coupling.max_dt` 2e-5 / 1e-5 s, 2.3 times with its mesh damped (`mesh_damping = 0.02`:
+//! the ringing of the block once thrown clear of the water made most of the rest; docs/CORRECTIONS.md "The
+//! structure's sub-steps of changing length"). What is left is the slam itself: the block reaches the floor with
+//! particles under it, which the contact and the walls squeeze between them (not fixed). A floating body lighter
+//! than the water is a legitimate scene, so this is a warning, not a refusal.
 
 use super::schema::Scene;
 
