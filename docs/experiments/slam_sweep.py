@@ -1,6 +1,15 @@
+"""Free blocks dropped onto the shipped gate's surge (docs/CORRECTIONS.md "The walls inside the structure's
+sub-steps"): the gate's solid made a block held nowhere, 1,100-8,000 kg/m3, E 12 MPa or 1 GPa, 3-12 cm wide, 1-12 cm
+above the floor, WCSPH or ISPH at 4-8 mm, 0.2 s in-process. Prints per scene the status and energy_growth.largest
+(in budgets) of each variant OFF:ZETA, where ZETA is solid[0].mesh_damping and OFF is put in COSIM_WALL_OFFSET (read
+only by the build of docs/experiments/wall_offset.diff; give 0 otherwise).
+
+    cargo build --release && python3 docs/experiments/slam_sweep.py SEED COUNT 0:0 0:0.02
+"""
 import random, subprocess, sys, os, json, tempfile, concurrent.futures as cf
 seed=int(sys.argv[1]); n=int(sys.argv[2]); variants=sys.argv[3:]  # each "OFF:ZETA"
-C="/work/main/target/release/cosim"; TMP=tempfile.mkdtemp(prefix="slam")
+ROOT=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+C=os.path.join(ROOT,"target/release/cosim"); TMP=tempfile.mkdtemp(prefix="slam")
 def sets_for(k):
     r=random.Random(seed*1000+k)
     sp=r.choice([0.004,0.006,0.008])
@@ -13,7 +22,7 @@ def sets_for(k):
     return s
 def run(job):
     k,v=job; off,z=v.split(":"); out=f"{TMP}/o{k}_{off}_{z}"
-    args=[C,"run","/work/main/scenes/elastic_gate.toml","--in-process","--quiet","--out",out]
+    args=[C,"run",os.path.join(ROOT,"scenes/elastic_gate.toml"),"--in-process","--quiet","--out",out]
     for s in sets_for(k)+[f"solid[0].mesh_damping={z}"]: args+=["--set",s]
     env=dict(os.environ,COSIM_WALL_OFFSET=off)
     try:
