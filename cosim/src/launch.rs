@@ -14,6 +14,7 @@ use contact_broker::summary::{Summary, SummaryBuilder};
 use cosim_bus::interrupt::Interrupt;
 use cosim_proto::scene::Scene;
 
+use crate::child_log::last_line;
 use crate::cli::{ExternalNode, RunArgs};
 use crate::progress::Bar;
 
@@ -121,29 +122,6 @@ fn spawn(name: &'static str, program: &Path, args: &[String], log: &Path, stdout
         .spawn()
         .with_context(|| format!("cannot start {}", program.display()))?;
     Ok(Guard { name, child })
-}
-
-/// What a log says last, to explain a failure in one line: the panic when the process panicked (its message, not
-/// the backtrace after it), else the last non-empty line.
-fn last_line(log: &Path) -> String {
-    let text = std::fs::read_to_string(log).unwrap_or_default();
-    panic_in(&text)
-        .or_else(|| text.lines().rev().find(|l| !l.trim().is_empty()).map(str::to_string))
-        .unwrap_or_else(|| "(no message)".into())
-}
-
-/// The last panic in a log, as "panicked at FILE:LINE:COL: MESSAGE" (Rust writes the message on the next line).
-fn panic_in(text: &str) -> Option<String> {
-    let mut lines = text.lines();
-    let mut found = None;
-    while let Some(line) = lines.next() {
-        if let Some(at) = line.find("panicked at ") {
-            let place = line[at..].trim_end().trim_end_matches(':');
-            let message = lines.next().map(str::trim).unwrap_or_default();
-            found = Some(format!("{place}: {message}"));
-        }
-    }
-    found
 }
 
 /// Events the broker prints on stdout.
@@ -476,26 +454,4 @@ fn kept_outputs(out: &Path) -> (u64, f64, u64) {
         })
     };
     (samples, sim_time, count("structure_").max(count("particles_")))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A panic is said by its message, not by the backtrace's last line.
-    #[test]
-    fn a_panic_is_said_by_its_message() {
-        let log = "2026-12-06T14:30:08Z  WARN zenoh: Scouting delay elapsed\n\
-                   thread 'main' (19754) panicked at library/core/src/time.rs:962:23:\n\
-                   cannot convert float seconds to Duration: value is either too big or NaN\n\
-                   stack backtrace:\n   5: main\nnote: Some details are omitted\n";
-        assert_eq!(
-            panic_in(log).as_deref(),
-            Some(
-                "panicked at library/core/src/time.rs:962:23: cannot convert float seconds to Duration: value is \
-                 either too big or NaN"
-            )
-        );
-        assert_eq!(panic_in("contact-broker: fem-node failed\n"), None);
-    }
 }

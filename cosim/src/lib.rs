@@ -7,6 +7,7 @@
 
 pub mod bench;
 pub mod check;
+pub mod child_log;
 pub mod cli;
 pub mod closed_stdout;
 pub mod compare;

@@ -33,8 +33,8 @@ pub use inputs::{Checkpoints, Nodes, RunInfo};
 use pause::{Debugger, Halt};
 pub use progress::{Control, Progress};
 use sampling::{Outputs, Series};
+pub use step_time::first_step;
 use step_time::Clock;
-pub use step_time::{first_step, shortest_step};
 
 /// A finished run: its summary (also written to `summary.json`) and the error that ended it, if any.
 pub struct Outcome {

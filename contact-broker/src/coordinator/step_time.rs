@@ -1,7 +1,7 @@
 //! The run's clock (`DESIGN.md` §3 step 1): how long each coupling step is, and the output times the steps land
 //! on.
 
-use cosim_proto::scene::{whole_fluid_steps, ContactAlgorithm, Scene, SUBSTEP_SLACK};
+use cosim_proto::scene::{shortest_step, whole_fluid_steps, ContactAlgorithm, Scene, SUBSTEP_SLACK};
 use cosim_proto::Num;
 
 use super::exchange::Round;
@@ -9,12 +9,6 @@ use crate::summary::Summary;
 
 /// Steps closer than this fraction of `max_dt` to an output time land on it.
 pub(super) const LANDING: f64 = 1e-9;
-
-/// The shortest coupling step a run takes, `coupling.max_dt` / 2^32 [s]: a shorter one cannot move the run on
-/// ([`Clock::check_step`]), and a restored bound below it is refused (`checkpoint::BrokerState::check`).
-pub fn shortest_step(max_dt: f64) -> f64 {
-    max_dt / 4_294_967_296.0
-}
 
 /// Where the run is in time, and the fluid's stable step that bounds the next coupling step.
 pub(super) struct Clock {

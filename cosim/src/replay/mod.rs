@@ -278,7 +278,7 @@ impl Player {
             Ok(Some(status)) => Err(Failed(format!(
                 "{} exited ({status}) before {what}: {}",
                 self.topics.name,
-                last_line(&self.log)
+                crate::child_log::last_line(&self.log)
             ))),
             _ => Ok(()),
         }
@@ -388,12 +388,4 @@ fn spawn(args: &ReplayArgs, run: &str, endpoint: &str, log: &Path) -> anyhow::Re
 /// node's parent; the node leads its process group either way, which the replay ends whole ([`Node`]).
 fn exec_script(line: &str) -> String {
     format!("{line} \"$@\"")
-}
-
-/// The last non-empty line of the node's log.
-fn last_line(log: &Path) -> String {
-    std::fs::read_to_string(log)
-        .ok()
-        .and_then(|s| s.lines().rev().find(|l| !l.trim().is_empty()).map(str::to_string))
-        .unwrap_or_else(|| "(nothing in its log)".into())
 }

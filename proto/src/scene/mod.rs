@@ -30,10 +30,10 @@ mod warnings;
 pub use impact::IMPACT_DENSITY_DIFFUSION;
 pub use load::{load, parse, LoadedScene, SceneError};
 pub use schema::{
-    whole_fluid_steps, Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec, DensityFilter,
-    ElementKind, EnergyOf, EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec, PpeSourceKind, ProbeKind,
-    ProbeSpec, ReferenceSpec, RunSpec, Scene, SolidSpec, FLUID_SUBSTEPS_MAX, ISPH_APD_DEFAULT,
-    ISPH_PPE_TOLERANCE_DEFAULT, ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION, STRUCTURE_COURANT_DEFAULT,
+    shortest_step, whole_fluid_steps, Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec,
+    DensityFilter, ElementKind, EnergyOf, EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec,
+    PpeSourceKind, ProbeKind, ProbeSpec, ReferenceSpec, RunSpec, Scene, SolidSpec, FLUID_SUBSTEPS_MAX,
+    ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT, ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION, STRUCTURE_COURANT_DEFAULT,
     STRUCTURE_COURANT_MIN, SUBSTEP_SLACK, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use sensors::{face_mean as sensors_face_mean, PressureSensor};

@@ -116,6 +116,12 @@ pub fn whole_fluid_steps(cap: f64, dt_fluid: f64, most: u32) -> u32 {
     }
 }
 
+/// The shortest coupling step a run takes, `coupling.max_dt` / 2^32 [s]: a shorter one cannot move the run on (the
+/// broker's clock refuses it), and a restored bound below it is refused (the broker's checkpoint check).
+pub fn shortest_step(max_dt: f64) -> f64 {
+    max_dt / 4_294_967_296.0
+}
+
 impl Scene {
     /// How many fluid steps of `dt_fluid` a coupling step spans at most: [`Scene::fluid_substeps`], fewer where
     /// `coupling.max_dt` holds fewer whole ones ([`whole_fluid_steps`]).

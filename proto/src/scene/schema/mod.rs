@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 
 pub use contact::{ContactAlgorithm, ContactSpec};
 pub use coupling::{
-    whole_fluid_steps, CouplingSpec, FLUID_SUBSTEPS_MAX, STRUCTURE_COURANT_DEFAULT, STRUCTURE_COURANT_MIN,
-    SUBSTEP_SLACK,
+    shortest_step, whole_fluid_steps, CouplingSpec, FLUID_SUBSTEPS_MAX, STRUCTURE_COURANT_DEFAULT,
+    STRUCTURE_COURANT_MIN, SUBSTEP_SLACK,
 };
 pub use fluid::{
     DensityFilter, FluidSolver, FluidSpec, PpeSourceKind, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT,
