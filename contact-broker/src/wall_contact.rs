@@ -33,7 +33,7 @@ impl WallContact {
                 *slot = true;
             }
         }
-        let all = walls.stopped(&mesh.nodes, &fixed);
+        let all = walls.stopped(&mesh.nodes, &fixed, &mesh.node_solid);
         let stopped: Vec<bool> = ids
             .iter()
             .map(|&id| all.get(id as usize).copied().unwrap_or(false))
@@ -147,11 +147,10 @@ material = { model = "linear_elastic", density = 1000.0, youngs_modulus = 1e6, p
     #[test]
     fn a_node_in_a_wall_is_put_on_its_face_and_stops_going_in() {
         // Node 0 on the floor's face, 1 above it, 2 fixed, 3 inside the floor from the start. Clamped by node 2, the
-        // solid's node 0 on the face is stopped as when the solid is free (the gate's free end on the floor; spared
-        // from 2026-12-07 to 12-08, `cosim_proto::walls`).
+        // solid's node 0 on the face is left alone too (the gate's free end on the floor); free, it is stopped.
         let nodes = vec![[0.5, 0.0], [0.5, 0.05], [0.6, 0.0], [0.7, -0.01]];
-        let held = WallContact::new(&scene(), &mesh(nodes.clone(), vec![2]), &[0, 1, 2, 3]).expect("nodes to stop");
-        assert_eq!(held.stopped, [true, true, false, false]);
+        let held = WallContact::new(&scene(), &mesh(nodes.clone(), vec![2]), &[0, 1, 2, 3]).expect("node 1 to stop");
+        assert_eq!(held.stopped, [false, true, false, false]);
         let m = mesh(nodes, Vec::new());
         let mut walls = WallContact::new(&scene(), &m, &[0, 1, 2, 3]).expect("three nodes to stop");
         assert_eq!(walls.stopped, [true, true, true, false]);

@@ -60,7 +60,7 @@ impl FemModel {
     /// The model of a scene's `[[solid]]`s under `run.gravity`.
     pub fn build(scene: &Scene) -> Result<Self> {
         let mut model = Self::from_solids(&scene.solids, scene.run.gravity)?;
-        model.walls = WallStop::new(scene, &model.reference, &model.fixed);
+        model.walls = WallStop::new(scene, &model.reference, &model.fixed, &model.node_solid);
         Ok(model)
     }
 

@@ -20,12 +20,12 @@ pub struct WallStop {
 }
 
 impl WallStop {
-    /// The walls of `scene` against the nodes at `reference` (clamped where `fixed`); `None` without walls (or a
-    /// fluid, whose boundary they are) or without a node to stop.
-    pub fn new(scene: &Scene, reference: &[[f64; 2]], fixed: &[bool]) -> Option<Self> {
+    /// The walls of `scene` against the nodes at `reference` (clamped where `fixed`, of solid `node_solid`);
+    /// `None` without walls (or a fluid, whose boundary they are) or without a node to stop.
+    pub fn new(scene: &Scene, reference: &[[f64; 2]], fixed: &[bool], node_solid: &[u32]) -> Option<Self> {
         let walls = Walls::new(scene)?;
         let nodes: Vec<usize> = walls
-            .stopped(reference, fixed)
+            .stopped(reference, fixed, node_solid)
             .iter()
             .enumerate()
             .filter_map(|(k, &s)| s.then_some(k))
