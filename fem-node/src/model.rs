@@ -60,7 +60,13 @@ impl FemModel {
     /// The model of a scene's `[[solid]]`s under `run.gravity`.
     pub fn build(scene: &Scene) -> Result<Self> {
         let mut model = Self::from_solids(&scene.solids, scene.run.gravity)?;
-        model.walls = WallStop::new(scene, &model.reference, &model.fixed, &model.node_solid);
+        model.walls = WallStop::new(
+            scene,
+            &model.reference,
+            &model.fixed,
+            &model.node_solid,
+            &model.boundary,
+        );
         Ok(model)
     }
 

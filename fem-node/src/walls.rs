@@ -8,6 +8,7 @@
 //! on the solid each step. An elastic block dropped onto the floor at 0.93 m/s left it ringing with 13 times the
 //! kinetic energy it fell with (docs/CORRECTIONS.md "The walls inside the structure's sub-steps").
 
+use cosim_proto::messages::Segment;
 use cosim_proto::scene::Scene;
 use cosim_proto::walls::Walls;
 
@@ -15,28 +16,36 @@ use cosim_proto::walls::Walls;
 #[derive(Clone, Debug, PartialEq)]
 pub struct WallStop {
     walls: Walls,
-    /// The stopped nodes, ascending.
+    /// The stopped nodes (on the outer boundary), ascending.
     nodes: Vec<usize>,
 }
 
 impl WallStop {
-    /// The walls of `scene` against the nodes at `reference` (clamped where `fixed`, of solid `node_solid`);
-    /// `None` without walls (or a fluid, whose boundary they are) or without a node to stop.
-    pub fn new(scene: &Scene, reference: &[[f64; 2]], fixed: &[bool], node_solid: &[u32]) -> Option<Self> {
+    /// The walls of `scene` against the nodes at `reference` (clamped where `fixed`, of solid `node_solid`) that lie on
+    /// the solids' outer `boundary` (an inner node reaches a wall only after the surface in front of it, which the
+    /// walls stop); `None` without walls (or a fluid, whose boundary they are) or without a node to stop.
+    pub fn new(
+        scene: &Scene,
+        reference: &[[f64; 2]],
+        fixed: &[bool],
+        node_solid: &[u32],
+        boundary: &[Segment],
+    ) -> Option<Self> {
         let walls = Walls::new(scene)?;
-        let nodes: Vec<usize> = walls
-            .stopped(reference, fixed, node_solid)
+        let stopped = walls.stopped(reference, fixed, node_solid);
+        let mut nodes: Vec<usize> = boundary
             .iter()
-            .enumerate()
-            .filter_map(|(k, &s)| s.then_some(k))
+            .flat_map(|s| [s.a as usize, s.b as usize])
+            .filter(|&k| stopped.get(k).copied().unwrap_or(false))
             .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
         (!nodes.is_empty()).then_some(Self { walls, nodes })
     }
 
     /// Puts every stopped node of `x` that lies inside a wall back on its surface, taking off the component of its
-    /// velocity `v` into the wall; whether any moved.
-    pub fn apply(&self, x: &mut [[f64; 2]], v: &mut [[f64; 2]]) -> bool {
-        let mut moved = false;
+    /// velocity `v` into the wall.
+    pub fn apply(&self, x: &mut [[f64; 2]], v: &mut [[f64; 2]]) {
         for &k in &self.nodes {
             let (Some(p), Some(u)) = (x.get_mut(k), v.get_mut(k)) else {
                 continue;
@@ -44,9 +53,7 @@ impl WallStop {
             if let Some((dx, dv)) = self.walls.stop(*p, *u) {
                 *p = [p[0] + dx[0], p[1] + dx[1]];
                 *u = [u[0] + dv[0], u[1] + dv[1]];
-                moved = true;
             }
         }
-        moved
     }
 }

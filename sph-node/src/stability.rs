@@ -3,8 +3,8 @@
 //! nowhere can give it by falling to that level, so kinetic energy beyond twice that budget means the solution is
 //! blowing up, and the run stops as `unstable` instead of writing garbage. (NaN and particles leaving the domain
 //! are caught inside the solvers.) Before 2026-12-08 the budget was the water's alone, and a heavy solid dropped into
-//! the water stopped runs that made no energy: an 8,000 kg/m³ block 97 × 29 mm falling from 12 cm onto the surge
-//! poured 1.4 times the water's budget into it, `unstable` at t = 0.162 s (`energy_growth` 0.0).
+//! the water stopped runs that made no energy: an 8,000 kg/m³ block 97 × 29 mm falling from 12 cm onto the surge,
+//! which can give the water about 3 times its own budget, ended `unstable` at t = 0.162 s (`energy_growth` 3.5e-5).
 
 use cosim_proto::scene::Scene;
 

@@ -225,8 +225,7 @@ fn is_teardown_panic(payload: &(dyn std::any::Any + Send)) -> bool {
 mod tests {
     use super::*;
 
-    /// A failure with the picked port still free (what a connect endpoint that does not answer gives) is not tried
-    /// again; one whose picked port another program holds is, with a new port each time.
+    /// zenoh-runtime's teardown panic is recognised by its message, and no other panic is.
     #[test]
     fn only_zenohs_teardown_panic_is_told_in_one_line() {
         let teardown = std::panic::catch_unwind(|| {
@@ -241,6 +240,8 @@ mod tests {
         assert!(!is_teardown_panic(other.as_ref()));
     }
 
+    /// A failure with the picked port still free (what a connect endpoint that does not answer gives) is not tried
+    /// again; one whose picked port another program holds is, with a new port each time.
     #[test]
     fn only_a_taken_port_is_tried_again() {
         let mut tried = Vec::new();
