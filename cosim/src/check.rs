@@ -148,10 +148,15 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             solid.fixed.len(),
             Num(solid.damping)
         );
-        if solid.mesh_damping > 0.0 {
+        if solid.mesh_damping() > 0.0 {
             println!(
-                "    mesh damping: stiffness-proportional, a ratio of {} at the mesh's highest mode",
-                Num(solid.mesh_damping)
+                "    mesh damping: stiffness-proportional, a ratio of {} at the mesh's highest mode{}",
+                Num(solid.mesh_damping()),
+                if solid.mesh_damping.is_none() {
+                    " (the default of a solid held nowhere)"
+                } else {
+                    ""
+                }
             );
         }
     }

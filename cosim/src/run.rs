@@ -226,7 +226,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<ExitCode> {
             }
             // A structure whose mesh rings under the contact's impulses: a tenth of the damping first measured holds
             // it as well (docs/CORRECTIONS.md "The structure's sub-steps of changing length").
-            if let Some(i) = scene.scene.solids.iter().position(|s| s.mesh_damping == 0.0) {
+            if let Some(i) = scene.scene.solids.iter().position(|s| s.mesh_damping() == 0.0) {
                 eprintln!(
                     "cosim: so is damping the structure's mesh-scale ringing, --set solid[{i}].mesh_damping=0.02 \
                      (docs/CORRECTIONS.md)"

@@ -265,8 +265,9 @@ fn check_warns_of_a_solid_held_nowhere() {
         "{w}"
     );
     // Run, the walls stop it (`fem_node::walls` inside the structure's sub-steps): a block dropped 5 mm above the
-    // floor, clear of the water, lands at t = 0.032 s (g t²/2 = 5 mm, 0.31 m/s) and bounces as an undamped elastic
-    // body does, to about a fifth of the drop and again (measured 0.95 mm; it rested within 0.6 µm of the face while
+    // floor, clear of the water, lands at t = 0.032 s (g t²/2 = 5 mm, 0.31 m/s) and bounces as an elastic body
+    // does, to about a fifth of the drop and again (measured 0.87 mm with its mesh damped at its own scale, the
+    // default of a solid held nowhere since 2026-12-08; 0.97 mm undamped; it rested within 0.6 µm of the face while
     // the broker stopped it once a coupling step, which made energy at faster landings: docs/CORRECTIONS.md "The
     // walls inside the structure's sub-steps"). Sampled every millisecond to t = 0.1 s, where a free fall would have
     // taken it 44 mm into the floor, its lowest node is never below the floor's face, comes within 0.5 mm of it

@@ -24,7 +24,7 @@ fn beam(element: ElementKind, model: MaterialModel) -> SolidSpec {
             max: [1e-9, 1.0],
         }],
         damping: 0.0,
-        mesh_damping: 0.0,
+        mesh_damping: Some(0.0),
     }
 }
 

@@ -114,7 +114,7 @@ mod tests {
                 max: [0.1, 1.1],
             }],
             damping: 0.0,
-            mesh_damping: 0.0,
+            mesh_damping: None,
         }
     }
 

@@ -123,11 +123,9 @@ impl FemModel {
                 spec.damping
             )));
         }
-        if !(spec.mesh_damping.is_finite() && (0.0..1.0).contains(&spec.mesh_damping)) {
-            return Err(invalid(format!(
-                "mesh_damping must be in [0, 1), got {}",
-                spec.mesh_damping
-            )));
+        let mesh_damping = spec.mesh_damping();
+        if !(mesh_damping.is_finite() && (0.0..1.0).contains(&mesh_damping)) {
+            return Err(invalid(format!("mesh_damping must be in [0, 1), got {mesh_damping}")));
         }
         if spec.divisions.contains(&0) {
             return Err(invalid(format!(
@@ -177,13 +175,13 @@ impl FemModel {
             nodes: first..self.reference.len(),
             elements: first_element..self.elements.len(),
         };
-        if spec.mesh_damping > 0.0 {
+        if mesh_damping > 0.0 {
             // ζ at the mesh's highest mode, ω_max ≈ 2 c_d / L_e of its shortest element: β = 2ζ / ω_max.
             let shortest = self.elements[solid.elements.clone()]
                 .iter()
                 .map(|e| e.characteristic_length(&self.reference))
                 .fold(f64::INFINITY, f64::min);
-            solid.stiffness_damping = spec.mesh_damping * shortest / solid.wave_speed();
+            solid.stiffness_damping = mesh_damping * shortest / solid.wave_speed();
         }
         self.solids.push(solid);
         Ok(())

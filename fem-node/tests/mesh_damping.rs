@@ -29,7 +29,7 @@ fn beam(mesh_damping: f64) -> SolidSpec {
         ElementKind::Quad4,
         material(MaterialModel::LinearElastic, RHO, E, NU),
     );
-    spec.mesh_damping = mesh_damping;
+    spec.mesh_damping = Some(mesh_damping);
     spec
 }
 

@@ -40,7 +40,7 @@ fn ringing_block(element: ElementKind, mesh_damping: f64, changing: bool) -> (f6
         material(MaterialModel::NeoHookean, 2700.0, 12.0e6, 0.4),
     );
     spec.fixed.clear();
-    spec.mesh_damping = mesh_damping;
+    spec.mesh_damping = Some(mesh_damping);
     let mut s = solver(spec, [0.0, 0.0], 0.9);
     // A smooth field (the block's first modes, 3 m/s) and a rough one (±1 m/s node to node: 13 % of the energy).
     s.set_velocities(|i, p| {

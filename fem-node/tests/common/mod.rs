@@ -35,7 +35,7 @@ pub fn cantilever(
             max: [x[0] + eps, y[1] + eps],
         }],
         damping: 0.0,
-        mesh_damping: 0.0,
+        mesh_damping: Some(0.0),
     }
 }
 

@@ -71,10 +71,10 @@ impl Scene {
                     "a fluid particle weighs {:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
-                     the solid's divisions, refine fluid.spacing, damp the ringing ({}.mesh_damping = 0.02) or spread \
-                     the load (contact.load_spread = 2; docs/CORRECTIONS.md)",
+                     the solid's divisions, refine fluid.spacing, {}spread the load (contact.load_spread = 2; \
+                     docs/CORRECTIONS.md)",
                     Num(ratio),
-                    self.solid_key(name)
+                    self.damping_hint(name, "damp the ringing ({}.mesh_damping = 0.02) or ")
                 )
             })
             .collect()
@@ -115,13 +115,17 @@ impl Scene {
                  fluid particle weighs {:.1} cells of solid `{name}`: measured on the gate, 24 FE steps a coupling \
                  step kept the energy and 48 did not (ISPH's own step, which the default coupling.max_dt = 1e-3 leaves \
                  free, made the 4 mm gate unstable without a bound from the structure's speed); try coupling.max_dt = \
-                 {:.0e}, or damp the structure's ringing ({}.mesh_damping = 0.02: the 4 mm gate then ends at ISPH's own \
-                 step; docs/CORRECTIONS.md){}",
+                 {:.0e}{}{}",
                 Num(ratio),
                 24.0 * fem_dt,
-                self.solid_key(name),
+                self.damping_hint(
+                    name,
+                    ", or damp the structure's ringing ({}.mesh_damping = 0.02: the 4 mm gate then ends at ISPH's own \
+                     step; docs/CORRECTIONS.md)"
+                ),
                 match self.contact.algorithm {
-                    ContactAlgorithm::ParticleElement => ", or bound the step by the structure's speed again \
+                    ContactAlgorithm::ParticleElement =>
+                        ", or bound the step by the structure's speed again \
                                                           (coupling.structure_courant = 0.05)",
                     _ => "",
                 }
@@ -140,6 +144,21 @@ impl Scene {
     fn solid_key(&self, name: &str) -> String {
         let i = self.solids.iter().position(|s| s.name == name).unwrap_or(0);
         format!("solid[{i}]")
+    }
+
+    /// `hint` with its `{}` replaced by the solid's key where solid `name` is undamped at its mesh's scale; empty
+    /// where it already is (a solid held nowhere by default, `FREE_MESH_DAMPING`).
+    fn damping_hint(&self, name: &str, hint: &str) -> String {
+        let undamped = self
+            .solids
+            .iter()
+            .find(|s| s.name == name)
+            .is_none_or(|s| s.mesh_damping() == 0.0);
+        if undamped {
+            hint.replace("{}", &self.solid_key(name))
+        } else {
+            String::new()
+        }
     }
 }
 
@@ -170,6 +189,14 @@ mod tests {
         let w = fine.heavy_particle_warnings();
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
+        assert!(
+            w[0].contains("damp the ringing (solid[0].mesh_damping = 0.02) or spread"),
+            "{}",
+            w[0]
+        );
+        // A solid held nowhere is damped already (FREE_MESH_DAMPING): no advice to damp it.
+        let free = gate(&["solid[0].divisions=[10,158]", "solid[0].fixed=[]"]).heavy_particle_warnings();
+        assert!(free[0].contains("refine fluid.spacing, spread the load"), "{}", free[0]);
         assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
         // The fluid sub-cycled between passes: the 4 mm gate's 14.5 cells warn where 2 or more of its fluid steps
         // (6.5e-5 s) fit under max_dt, not under the shipped 1e-4 (1.5 steps), not in lockstep, not with ISPH (which
@@ -201,6 +228,20 @@ mod tests {
             w.contains("spans 151 FE steps")
                 && w.contains("coupling.max_dt = 1e-4")
                 && w.contains("coupling.structure_courant = 0.05"),
+            "{w}"
+        );
+        assert!(
+            w.contains("or damp the structure's ringing (solid[0].mesh_damping = 0.02"),
+            "{w}"
+        );
+        let free = gate(&[
+            "fluid.solver=\"isph\"",
+            "coupling.structure_courant=0",
+            "solid[0].fixed=[]",
+        ]);
+        let w = free.long_coupling_step_warning(6.3e-4, 4.16e-6, 151).unwrap();
+        assert!(
+            !w.contains("mesh_damping") && w.contains("coupling.max_dt = 1e-4, or bound"),
             "{w}"
         );
         assert!(gate(&["fluid.solver=\"isph\""])

@@ -33,8 +33,8 @@ pub use schema::{
     shortest_step, whole_fluid_steps, Average, BoxSpec, Component, ContactAlgorithm, ContactSpec, CouplingSpec,
     DensityFilter, ElementKind, EnergyOf, EnergyPart, FluidSolver, FluidSpec, MaterialModel, MaterialSpec,
     PpeSourceKind, ProbeKind, ProbeSpec, ReferenceSpec, RunSpec, Scene, SolidSpec, FLUID_SUBSTEPS_MAX,
-    ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT, ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION, STRUCTURE_COURANT_DEFAULT,
-    STRUCTURE_COURANT_MIN, SUBSTEP_SLACK, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
+    FREE_MESH_DAMPING, ISPH_APD_DEFAULT, ISPH_PPE_TOLERANCE_DEFAULT, ISPH_PPE_TOLERANCE_RANGE, SCENE_VERSION,
+    STRUCTURE_COURANT_DEFAULT, STRUCTURE_COURANT_MIN, SUBSTEP_SLACK, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use sensors::{face_mean as sensors_face_mean, PressureSensor};
 

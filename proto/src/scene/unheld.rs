@@ -1,18 +1,19 @@
 //! A solid held nowhere: what a user should know before gravity moves it as a whole.
 //!
 //! A solid with no `fixed` box is moved by gravity and the water alone, and only the walls (`[[wall]]`) stop it:
-//! a node that a step takes into a wall is put back on the wall's surface without friction or rebound of the node
-//! (`crate::walls`; fem-node within every sub-step, the broker after each contact pass; before 2026-12-07 a solid
-//! passed through the walls, and until 2026-12-08 the broker's once-a-step stop made energy as an elastic solid
-//! landed). Such a body sinks or floats, and the water caught under one that falls is squeezed hard: measured
+//! a node that a step takes into a wall is put back on the wall's surface without friction, its velocity into the
+//! wall taken off (`crate::walls`; fem-node within every sub-step, the broker after each contact pass; before
+//! 2026-12-07 a solid passed through the walls, and until 2026-12-08 the broker's once-a-step stop made energy as an
+//! elastic solid landed). The body itself is elastic: dropped on the floor it bounces, as an undamped elastic body
+//! does. Such a body sinks or floats, and the water caught under one that falls is squeezed hard: measured
 //! (2026-12-07, a random sweep of coupled scenes), an aluminium-dense block 9 × 4 cm dropped 5 cm beside the shipped
 //! gate's column onto the surge along the floor made 15 times the energy the water can release with WCSPH (thrown
-//! back up; 9.0 times since 2026-12-08) and ended `unstable` with ISPH, a shorter coupling step the first thing to
-//! try: 1.17 / 0.95 times at `coupling.max_dt` 2e-5 / 1e-5 s, 2.3 times with its mesh damped (`mesh_damping = 0.02`:
-//! the ringing of the block once thrown clear of the water made most of the rest; docs/CORRECTIONS.md "The
-//! structure's sub-steps of changing length"). What is left is the slam itself: the block reaches the floor with
-//! particles under it, which the contact and the walls squeeze between them (not fixed). A floating body lighter
-//! than the water is a legitimate scene, so this is a warning, not a refusal.
+//! back up; 9.0 times since 2026-12-08), most of it in the ringing of the mesh's highest modes. Since 2026-12-08
+//! (thirty-sixth session) a solid held nowhere is damped at its mesh's scale unless the scene says otherwise
+//! (`mesh_damping` [`super::schema::FREE_MESH_DAMPING`] = 0.02): the same block made 0.93 times. What is left is the
+//! slam itself: the block reaches the floor with particles under it, which the contact and the walls squeeze between
+//! them (not fixed); a shorter `coupling.max_dt` is the lever then. A floating body lighter than the water is a
+//! legitimate scene, so this is a warning, not a refusal.
 
 use super::schema::Scene;
 
@@ -39,11 +40,18 @@ impl Scene {
                     ),
                     None => "with no fluid, it falls freely".to_string(),
                 };
+                let damping = match s.mesh_damping {
+                    None => format!(
+                        "its mesh is damped at its own scale by default (solid[{i}].mesh_damping = {})",
+                        crate::Num(s.mesh_damping())
+                    ),
+                    Some(z) => format!("solid[{i}].mesh_damping = {}", crate::Num(z)),
+                };
                 format!(
                     "solid `{}` is held nowhere (no `fixed` box): gravity and the water move it as a whole and only \
-                     the walls stop it, without friction or rebound (water caught under a falling solid is squeezed \
-                     hard: a shorter coupling.max_dt is the first thing to try if the run warns of energy made, then \
-                     solid[{i}].mesh_damping = 0.02); {fate}",
+                     the walls stop it, without friction (an elastic body, it bounces; {damping}); water caught \
+                     under a falling solid is squeezed hard: a shorter coupling.max_dt is the first thing to try if \
+                     the run warns of energy made; {fate}",
                     s.name
                 )
             })
@@ -70,7 +78,22 @@ mod tests {
             "{}",
             heavy[0]
         );
-        assert!(heavy[0].contains("then solid[0].mesh_damping = 0.02);"), "{}", heavy[0]);
+        assert!(
+            heavy[0].contains("(an elastic body, it bounces; its mesh is damped at its own scale by default (solid[0].mesh_damping = 0.02))"),
+            "{}",
+            heavy[0]
+        );
+        let undamped = gate(&[
+            "solid[0].fixed=[]",
+            "solid[0].mesh_damping=0",
+            "solid[0].material.density=2700.0",
+        ]);
+        let undamped = undamped.unheld_solid_warnings();
+        assert!(
+            undamped[0].contains("(an elastic body, it bounces; solid[0].mesh_damping = 0)"),
+            "{}",
+            undamped[0]
+        );
         assert!(
             heavy[0].ends_with("heavier than the water (2700 > 1000 kg/m³), it sinks"),
             "{}",

@@ -127,17 +127,30 @@ fn load_spread_defaults_to_zero_in_its_range() {
     }
 }
 
-/// `solid[i].mesh_damping` (the damping ratio of the mesh's highest mode): 0 by default and then not written to the
-/// resolved scene; in [0, 1); a bad value is refused with one line naming the key.
+/// `solid[i].mesh_damping` (the damping ratio of the mesh's highest mode): where the scene gives none, 0 for a
+/// clamped solid and `FREE_MESH_DAMPING` (0.02) for one held nowhere, and then not written to the resolved scene; a
+/// value given, 0 included, is the one in force; in [0, 1); a bad value is refused with one line naming the key.
 #[test]
-fn mesh_damping_defaults_to_zero_in_its_range() {
+fn mesh_damping_defaults_by_how_the_solid_is_held_in_its_range() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/elastic_gate.toml");
     let text = std::fs::read_to_string(path).unwrap();
     let s = parse("g.toml", &text, &[]).unwrap();
-    assert_eq!(s.solids[0].mesh_damping, 0.0);
+    assert_eq!((s.solids[0].mesh_damping, s.solids[0].mesh_damping()), (None, 0.0));
     assert!(!s.to_toml().contains("mesh_damping"));
+    let free = parse("g.toml", &text, &["solid[0].fixed=[]".into()]).unwrap();
+    assert_eq!(free.solids[0].mesh_damping(), cosim_proto::scene::FREE_MESH_DAMPING);
+    assert_eq!(cosim_proto::scene::FREE_MESH_DAMPING, 0.02);
+    assert!(!free.to_toml().contains("mesh_damping"));
+    let undamped = parse(
+        "g.toml",
+        &text,
+        &["solid[0].fixed=[]".into(), "solid[0].mesh_damping=0".into()],
+    )
+    .unwrap();
+    assert_eq!(undamped.solids[0].mesh_damping(), 0.0);
+    assert_eq!(parse("resolved", &undamped.to_toml(), &[]).unwrap(), undamped);
     let s = parse("g.toml", &text, &["solid[0].mesh_damping=0.25".into()]).unwrap();
-    assert_eq!(s.solids[0].mesh_damping, 0.25);
+    assert_eq!(s.solids[0].mesh_damping(), 0.25);
     assert_eq!(parse("resolved", &s.to_toml(), &[]).unwrap(), s);
     for bad in ["1", "1.5", "-0.1", "nan", "inf"] {
         let e = err(&text, &[&format!("solid[0].mesh_damping={bad}")]);

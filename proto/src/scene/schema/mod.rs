@@ -19,7 +19,7 @@ pub use fluid::{
     ISPH_PPE_TOLERANCE_RANGE, WCSPH_APD_DEFAULT, WCSPH_VERLET_SKIN_DEFAULT,
 };
 pub use probe::{Average, Component, EnergyOf, EnergyPart, ProbeKind, ProbeSpec, ReferenceSpec};
-pub use solid::{ElementKind, MaterialModel, MaterialSpec, SolidSpec};
+pub use solid::{ElementKind, MaterialModel, MaterialSpec, SolidSpec, FREE_MESH_DAMPING};
 
 /// The scene format version this build reads.
 pub const SCENE_VERSION: u32 = 1;

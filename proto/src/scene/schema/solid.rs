@@ -67,9 +67,29 @@ pub struct SolidSpec {
     /// internal forces are taken at x + β v with β = ζ · min_e L_e / c_d of the reference mesh, so a mode of angular
     /// frequency ω is damped by the ratio β ω / 2 — ζ at the mesh's own scale (ω ≈ 2 c_d / L_e), a thousandth of it
     /// or less for the bending modes a scene looks at (`fem-node/src/solver/central_difference.rs`). In [0, 1); 0
-    /// (default) is off.
-    #[serde(default, skip_serializing_if = "super::is_zero")]
-    pub mesh_damping: f64,
+    /// (default) is off for a solid held by a `fixed` box; a solid held nowhere takes [`FREE_MESH_DAMPING`] unless
+    /// the scene gives it a value ([`SolidSpec::mesh_damping`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh_damping: Option<f64>,
+}
+
+/// The `mesh_damping` of a solid held nowhere that the scene gives none (2026-12-08, thirty-sixth session). Such a
+/// body lands on floors and slams onto water, and the contact's and the walls' impulses ring its mesh's highest
+/// modes, which an undamped explicit mesh keeps and, under coupling steps of changing length, grows. Measured on
+/// free blocks dropped onto the shipped gate's surge (`docs/experiments/slam_sweep.py 1 16` and `5 10`, and the
+/// thirty-fourth session's sweep block), the energy the coupled run made, in the water's releasable energy,
+/// undamped → 0.02: 8.96 → 0.93, 1.66 → 0.02, 1.28 → 0.92, 0.93 → 0.35, 0.85 → 0.29, 0.21 → 0.002, never higher in
+/// a run that ended `ok` (docs/CORRECTIONS.md "A solid held nowhere is damped at its mesh's scale"). A clamped solid
+/// keeps 0: the hydrostatic plate's load swings more when its mesh is damped.
+pub const FREE_MESH_DAMPING: f64 = 0.02;
+
+impl SolidSpec {
+    /// The damping ratio at the mesh's highest mode in force: the scene's `mesh_damping`, or where it gives none
+    /// [`FREE_MESH_DAMPING`] for a solid with no `fixed` box and 0 for a clamped one.
+    pub fn mesh_damping(&self) -> f64 {
+        self.mesh_damping
+            .unwrap_or(if self.fixed.is_empty() { FREE_MESH_DAMPING } else { 0.0 })
+    }
 }
 
 fn default_element() -> ElementKind {

@@ -46,16 +46,18 @@ pub(super) fn validate_solid(s: usize, solid: &SolidSpec) -> Result<(), Invalid>
         || format!("must be zero or positive, got {}", Num(solid.damping)),
     )?;
     magnitude(&key("damping"), solid.damping, "1/s")?;
-    check(
-        solid.mesh_damping.is_finite() && (0.0..1.0).contains(&solid.mesh_damping),
-        || key("mesh_damping"),
-        || {
-            format!(
-                "must be in [0, 1) (the damping ratio of the mesh's highest mode), got {}",
-                Num(solid.mesh_damping)
-            )
-        },
-    )?;
+    if let Some(zeta) = solid.mesh_damping {
+        check(
+            zeta.is_finite() && (0.0..1.0).contains(&zeta),
+            || key("mesh_damping"),
+            || {
+                format!(
+                    "must be in [0, 1) (the damping ratio of the mesh's highest mode), got {}",
+                    Num(zeta)
+                )
+            },
+        )?;
+    }
     for (f, b) in solid.fixed.iter().enumerate() {
         check(
             b.min.iter().chain(&b.max).all(|v| v.is_finite()),
