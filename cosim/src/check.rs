@@ -63,6 +63,9 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let fluid_steps = fluid.as_ref().map(|_| (s.run.end_time / dt_fluid).ceil());
     let element_steps = elements as f64 * steps as f64 * substeps.unwrap_or(0) as f64;
     let particle_steps = particles as f64 * fluid_steps.unwrap_or(0.0);
+    // What that work costs on one core at the rates measured here (estimate.rs): seconds, hours or years.
+    let cpu_seconds =
+        crate::estimate::cpu_seconds(element_steps, particle_steps, s.fluid.as_ref().map(|f| f.solver), steps);
     if args.json {
         let doc = serde_json::json!({
             "scene": args.scene.display().to_string(),
@@ -80,7 +83,7 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
             "coupling_fluid_steps_per_pass": coupled.then_some(fluid_span),
             "fem_dt_stable": dt_fem,
             "fem_substeps_per_step": substeps,
-            "work": { "element_steps": element_steps, "particle_steps": particle_steps },
+            "work": { "element_steps": element_steps, "particle_steps": particle_steps, "cpu_seconds": cpu_seconds },
             // A fluid particle's mass over one mesh cell's, per solid (proto::scene::mass_ratio).
             "particle_to_cell_mass": ratios
                 .iter()
@@ -228,6 +231,12 @@ pub fn check(args: &CheckArgs) -> anyhow::Result<ExitCode> {
          has each solver's rate)",
         count(element_steps),
         count(particle_steps)
+    );
+    println!(
+        "  time: about {} of CPU on one core at the rates measured on this project's 2-core machine (docs/PERFORMANCE.md; \
+         a machine and the flow move it by up to about twice either way, and two threads take roughly 0.6 of it in \
+         wall time)",
+        crate::estimate::duration_text(cpu_seconds)
     );
     // A node the scene does not start has no share.
     let part = |p: Part, name: &str| (sizing.bytes(p) > 0.0).then(|| format!("{name} {}", bytes_text(sizing.bytes(p))));

@@ -12,6 +12,7 @@ pub mod cli;
 pub mod closed_stdout;
 pub mod compare;
 pub mod ctl;
+pub mod estimate;
 pub mod in_process;
 pub mod inspect;
 pub mod join;

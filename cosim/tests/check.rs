@@ -411,3 +411,25 @@ fn check_estimates_the_work_a_run_does() {
         }
     }
 }
+
+/// `cosim check` says what a run's work costs in CPU seconds on one core (`work.cpu_seconds`, `estimate.rs`): for
+/// telling seconds from hours, so it must come within twice the CPU time the shipped scenes take as `cosim run`
+/// (three processes, one thread each, `--threads 1`; user + sys of the whole command, `/usr/bin/time`, this
+/// project's 2-core machine, 2026-12-08; the estimates 33.2, 17.4, 10.5, 5.45, 20.4 and 14.8 s).
+#[test]
+fn check_estimates_the_cpu_time_of_the_shipped_scenes() {
+    for (scene, sets, measured) in [
+        ("scenes/elastic_gate.toml", &[][..], 37.2),
+        ("scenes/elastic_obstacle.toml", &[][..], 15.6),
+        ("scenes/hydrostatic_plate.toml", &[][..], 13.9),
+        ("scenes/csm3.toml", &[][..], 4.9),
+        ("scenes/dam_break.toml", &[][..], 18.4),
+        ("scenes/lobovsky_dam_break.toml", &["fluid.solver=\"isph\""][..], 15.5),
+    ] {
+        let estimate = check_json(scene, sets)["work"]["cpu_seconds"].as_f64().unwrap();
+        assert!(
+            estimate > 0.5 * measured && estimate < 2.0 * measured,
+            "{scene} {sets:?}: estimated {estimate:.1} CPU-s, measured {measured} CPU-s"
+        );
+    }
+}
