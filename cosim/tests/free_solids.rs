@@ -22,54 +22,65 @@ use std::time::Duration;
 
 use common::*;
 
-#[test]
-fn a_heavy_block_dropped_on_the_floor_bounces_without_making_energy() {
-    let dir = scratch("solid-on-walls");
+/// The shipped gate in-process with `sets` (its solid made a free block, its probes moved onto it): the run's
+/// `summary.json` and `probes.csv`, once it ended `ok`.
+fn free_block(name: &str, sets: &[&str]) -> (serde_json::Value, String) {
+    let dir = scratch(name);
     let out = dir.join("out");
-    let output = cosim_run(
-        &[
-            "run",
-            &root().join("scenes/elastic_gate.toml").display().to_string(),
-            "--in-process",
-            "--quiet",
-            "--out",
-            &out.display().to_string(),
-            "--set",
-            "fluid.spacing=0.006",
-            "--set",
-            "run.end_time=0.15",
-            "--set",
-            "solid[0].min=[0.6,0.0455]",
-            "--set",
-            "solid[0].max=[0.6867,0.0847]",
-            "--set",
-            "solid[0].divisions=[40,20]",
-            "--set",
-            "solid[0].fixed=[]",
-            "--set",
-            "solid[0].element=\"tri3\"",
-            "--set",
-            "solid[0].material.density=2700",
-            "--set",
-            "coupling.fluid_substeps=1",
-            "--set",
-            "run.output_interval=0.0005",
-            "--set",
-            "run.frame_interval=0.15",
-            "--set",
-            "probe[0].point=[0.64335,0.0455]",
-            "--set",
-            "probe[1].point=[0.64335,0.0455]",
-            // Undamped (a solid held nowhere is damped at its mesh's scale by default): the walls' rule alone.
-            "--set",
-            "solid[0].mesh_damping=0",
-        ],
-        Duration::from_secs(120),
-    );
+    let mut args = vec![
+        "run".to_string(),
+        root().join("scenes/elastic_gate.toml").display().to_string(),
+        "--in-process".into(),
+        "--quiet".into(),
+        "--out".into(),
+        out.display().to_string(),
+    ];
+    for set in sets {
+        args.push("--set".into());
+        args.push(set.to_string());
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = cosim_run(&args, Duration::from_secs(120));
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     let s = json(&out.join("summary.json"));
     assert_eq!(s["status"], "ok", "{s}");
+    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    (s, probes)
+}
+
+/// The third column (the first probe's y displacement) of every sample of `probes`.
+fn first_probe_y(probes: &str) -> Vec<f64> {
+    probes
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+        .collect()
+}
+
+#[test]
+fn a_heavy_block_dropped_on_the_floor_bounces_without_making_energy() {
+    let (s, probes) = free_block(
+        "solid-on-walls",
+        &[
+            "fluid.spacing=0.006",
+            "run.end_time=0.15",
+            "solid[0].min=[0.6,0.0455]",
+            "solid[0].max=[0.6867,0.0847]",
+            "solid[0].divisions=[40,20]",
+            "solid[0].fixed=[]",
+            "solid[0].element=\"tri3\"",
+            "solid[0].material.density=2700",
+            "coupling.fluid_substeps=1",
+            "run.output_interval=0.0005",
+            "run.frame_interval=0.15",
+            "probe[0].point=[0.64335,0.0455]",
+            "probe[1].point=[0.64335,0.0455]",
+            // Undamped (a solid held nowhere is damped at its mesh's scale by default): the walls' rule alone.
+            "solid[0].mesh_damping=0",
+        ],
+    );
     assert!(s["solid_in_wall"].is_null(), "{}", s["solid_in_wall"]);
     // The water's releasable energy is the budget; the block falls 45.5 mm (0.93 m/s at the floor) and lands at
     // t = 0.096 s, the water's surge 0.3 m away. Measured 6.4e-5 of the budget (the fluid's own); 25.6 before.
@@ -77,12 +88,7 @@ fn a_heavy_block_dropped_on_the_floor_bounces_without_making_energy() {
     assert!(gain < 0.01, "energy made: {gain} of the water's releasable energy");
     // The bottom's middle node, sampled every 0.5 ms, is never below the floor's face, comes within a sample's
     // fall of it (0.93 m/s × 0.5 ms), and leaves it again: the block bounces at about half its landing speed.
-    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
-    let ys: Vec<f64> = probes
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
-        .collect();
+    let ys = first_probe_y(&probes);
     let lowest = ys.iter().fold(f64::INFINITY, |m, &y| m.min(y));
     assert!(lowest >= -0.0455, "the bottom at y = {} m", 0.0455 + lowest);
     assert!(
@@ -96,7 +102,6 @@ fn a_heavy_block_dropped_on_the_floor_bounces_without_making_energy() {
         "did not bounce: {} m above the floor at the end",
         0.0455 + last
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -105,69 +110,33 @@ fn a_block_sinking_into_the_water_is_no_blow_up() {
     // about 3 times the 11 J/m it can release itself. Before 2026-12-08: `unstable` at t = 0.162 s, "kinetic energy
     // 2.1977e1 J/m exceeds twice the initial energy budget (2.1974e1 J/m)", with nothing made (`energy_growth`
     // largest 3.5e-5 of the budget at the last output time). Measured after: `ok`, the same 3.5e-5.
-    let dir = scratch("free-solid-sinking");
-    let out = dir.join("out");
-    let mut args = vec![
-        "run".to_string(),
-        root().join("scenes/elastic_gate.toml").display().to_string(),
-        "--in-process".into(),
-        "--quiet".into(),
-        "--out".into(),
-        out.display().to_string(),
-    ];
-    for set in [
-        "fluid.spacing=0.004",
-        "run.end_time=0.2",
-        "solid[0].min=[0.10238,0.11949]",
-        "solid[0].max=[0.19890,0.14863]",
-        "solid[0].divisions=[32,9]",
-        "probe[0].point=[0.15064,0.11949]",
-        "probe[1].point=[0.15064,0.11949]",
-        "solid[0].fixed=[]",
-        "solid[0].element=\"tri3\"",
-        "solid[0].material.density=8000.0",
-        "coupling.fluid_substeps=1",
-    ] {
-        args.push("--set".into());
-        args.push(set.into());
-    }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let output = cosim_run(&args, Duration::from_secs(120));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{stderr}");
-    let s = json(&out.join("summary.json"));
-    assert_eq!(s["status"], "ok", "{s}");
+    let (s, probes) = free_block(
+        "free-solid-sinking",
+        &[
+            "fluid.spacing=0.004",
+            "run.end_time=0.2",
+            "solid[0].min=[0.10238,0.11949]",
+            "solid[0].max=[0.19890,0.14863]",
+            "solid[0].divisions=[32,9]",
+            "probe[0].point=[0.15064,0.11949]",
+            "probe[1].point=[0.15064,0.11949]",
+            "solid[0].fixed=[]",
+            "solid[0].element=\"tri3\"",
+            "solid[0].material.density=8000.0",
+            "coupling.fluid_substeps=1",
+        ],
+    );
     // The block sank through the water (its bottom's middle 11.4 cm lower at the end, 5 mm above the floor) and
     // nothing was made.
     let gain = s["energy_growth"]["largest"].as_f64().unwrap();
     assert!(gain < 0.01, "energy made: {gain} of the water's releasable energy");
-    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
-    let last: f64 = probes
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .nth(2)
-        .unwrap()
-        .parse()
-        .unwrap();
+    let last = *first_probe_y(&probes).last().unwrap();
     assert!(last < -0.05, "the block's bottom moved only {last} m");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The run's `energy_growth.largest` (a fraction of the water's releasable energy): the thirty-fourth session's
 /// sweep block (2,700 kg/m³, 87 × 39 mm, 40 × 20 tri3 cells) dropped 5.5 cm onto the gate's surge, with `sets` added.
 fn slam(name: &str, sets: &[&str]) -> f64 {
-    let dir = scratch(name);
-    let out = dir.join("out");
-    let mut args = vec![
-        "run".to_string(),
-        root().join("scenes/elastic_gate.toml").display().to_string(),
-        "--in-process".into(),
-        "--quiet".into(),
-        "--out".into(),
-        out.display().to_string(),
-    ];
     let scene = [
         "fluid.spacing=0.006",
         "run.end_time=0.15",
@@ -181,19 +150,8 @@ fn slam(name: &str, sets: &[&str]) -> f64 {
         "solid[0].material.density=2700",
         "coupling.fluid_substeps=1",
     ];
-    for set in scene.iter().chain(sets) {
-        args.push("--set".into());
-        args.push(set.to_string());
-    }
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let output = cosim_run(&args, Duration::from_secs(120));
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{stderr}");
-    let s = json(&out.join("summary.json"));
-    assert_eq!(s["status"], "ok", "{s}");
-    let gain = s["energy_growth"]["largest"].as_f64().unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    gain
+    let all: Vec<&str> = scene.iter().chain(sets).copied().collect();
+    free_block(name, &all).0["energy_growth"]["largest"].as_f64().unwrap()
 }
 
 #[test]
