@@ -71,10 +71,10 @@ impl Scene {
                     "a fluid particle weighs {:.0} cells of solid `{name}` (above {HEAVY_PARTICLE:.0}): the contact's \
                      impulses ring a mesh that fine and the coupled run gains energy (measured on the gate: 0.11 of \
                      the water's releasable energy at 58 with WCSPH, 0.44 with ISPH at coupling.max_dt 1e-4); coarsen \
-                     the solid's divisions, refine fluid.spacing, {}spread the load (contact.load_spread = 2; \
+                     the solid's divisions, refine fluid.spacing, {}or spread the load (contact.load_spread = 2; \
                      docs/CORRECTIONS.md)",
                     Num(ratio),
-                    self.damping_hint(name, "damp the ringing ({}.mesh_damping = 0.02) or ")
+                    self.damping_hint(name, "damp the ringing ({}.mesh_damping = 0.02), ")
                 )
             })
             .collect()
@@ -190,13 +190,17 @@ mod tests {
         assert_eq!(w.len(), 1, "{w:?}");
         assert!(w[0].contains("weighs 58 cells of solid `gate`"), "{}", w[0]);
         assert!(
-            w[0].contains("damp the ringing (solid[0].mesh_damping = 0.02) or spread"),
+            w[0].contains("damp the ringing (solid[0].mesh_damping = 0.02), or spread"),
             "{}",
             w[0]
         );
         // A solid held nowhere is damped already (FREE_MESH_DAMPING): no advice to damp it.
         let free = gate(&["solid[0].divisions=[10,158]", "solid[0].fixed=[]"]).heavy_particle_warnings();
-        assert!(free[0].contains("refine fluid.spacing, spread the load"), "{}", free[0]);
+        assert!(
+            free[0].contains("refine fluid.spacing, or spread the load"),
+            "{}",
+            free[0]
+        );
         assert!(gate(&["contact.algorithm=\"none\""]).particle_to_cell_mass().is_empty());
         // The fluid sub-cycled between passes: the 4 mm gate's 14.5 cells warn where 2 or more of its fluid steps
         // (6.5e-5 s) fit under max_dt, not under the shipped 1e-4 (1.5 steps), not in lockstep, not with ISPH (which
