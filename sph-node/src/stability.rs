@@ -87,7 +87,7 @@ pub fn free_solids(scene: &Scene) -> Vec<(f64, [f64; 2])> {
     scene
         .solids
         .iter()
-        .filter(|s| s.fixed.is_empty())
+        .filter(|s| s.held_nowhere())
         .map(|s| {
             let area = (s.max[0] - s.min[0]) * (s.max[1] - s.min[1]);
             let centre = [0.5 * (s.min[0] + s.max[0]), 0.5 * (s.min[1] + s.max[1])];

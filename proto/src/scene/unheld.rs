@@ -27,7 +27,7 @@ impl Scene {
         self.solids
             .iter()
             .enumerate()
-            .filter(|(_, s)| s.fixed.is_empty())
+            .filter(|(_, s)| s.held_nowhere())
             .map(|(i, s)| {
                 let rho_s = s.material.density;
                 let fate = match &self.fluid {

@@ -84,11 +84,17 @@ pub struct SolidSpec {
 pub const FREE_MESH_DAMPING: f64 = 0.02;
 
 impl SolidSpec {
+    /// Whether the solid is held nowhere (no `fixed` box): gravity and the water move it as a whole, only the walls
+    /// stop it (`crate::scene::unheld`), and what it can give the water by sinking counts in the fluid's energy guard.
+    pub fn held_nowhere(&self) -> bool {
+        self.fixed.is_empty()
+    }
+
     /// The damping ratio at the mesh's highest mode in force: the scene's `mesh_damping`, or where it gives none
-    /// [`FREE_MESH_DAMPING`] for a solid with no `fixed` box and 0 for a clamped one.
+    /// [`FREE_MESH_DAMPING`] for a solid held nowhere and 0 for a clamped one.
     pub fn mesh_damping(&self) -> f64 {
         self.mesh_damping
-            .unwrap_or(if self.fixed.is_empty() { FREE_MESH_DAMPING } else { 0.0 })
+            .unwrap_or(if self.held_nowhere() { FREE_MESH_DAMPING } else { 0.0 })
     }
 }
 
